@@ -1,0 +1,182 @@
+//! Size queries through the C ABI. All are const and thread-safe.
+
+use super::boundary::*;
+use super::grid::abgs_grid;
+
+/// Answer of `abgs_query_closest`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default)]
+pub struct abgs_hit {
+    /// Triangle holding the closest point.
+    pub triangle: u32,
+    /// Barycentric coordinates on that triangle.
+    pub bary: [f64; 3],
+    /// The closest point.
+    pub point: [f64; 3],
+    /// Distance to the surface.
+    pub distance: f64,
+    /// Interpolated size (NaN when the grid has no sizes).
+    pub size: f64,
+}
+
+/// Size at `point` (3 doubles): exact closest point on the grid, barycentric
+/// interpolation there. Expected O(log F).
+/// Errors: NULL, NON_FINITE, NO_SIZES, BUSY (a mutation is running).
+#[no_mangle]
+pub unsafe extern "C" fn abgs_query_size(
+    grid: *const abgs_grid,
+    point: *const f64,
+    out_size: *mut f64,
+) -> abgs_status {
+    guard("abgs_query_size", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        // SAFETY: three doubles or NULL (checked).
+        let p = unsafe { point3(point, "point")? };
+        // SAFETY: writable or NULL (checked).
+        let o = unsafe { out(out_size, "out_size")? };
+        *o = g.query_size(p)?;
+        Ok(())
+    })
+}
+
+/// As `abgs_query_size`, seeded by `*hint` (a triangle index from an earlier
+/// query, or `ABGS_NO_HINT`; any value is safe) and updating it to the triangle
+/// of this answer. The size equals `abgs_query_size`'s bit for bit; only the time
+/// changes (coherent queries, as an advancing front makes, are much faster).
+#[no_mangle]
+pub unsafe extern "C" fn abgs_query_size_hinted(
+    grid: *const abgs_grid,
+    point: *const f64,
+    hint: *mut u32,
+    out_size: *mut f64,
+) -> abgs_status {
+    guard("abgs_query_size_hinted", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        // SAFETY: three doubles or NULL (checked).
+        let p = unsafe { point3(point, "point")? };
+        // SAFETY: writable or NULL (checked).
+        let h = unsafe { out(hint, "hint")? };
+        // SAFETY: writable or NULL (checked).
+        let o = unsafe { out(out_size, "out_size")? };
+        *o = g.query_size_hinted(p, h)?;
+        Ok(())
+    })
+}
+
+/// Sizes at `n` points (`points`: 3n doubles) into `out_sizes` (n doubles),
+/// in parallel on the rayon thread pool (`RAYON_NUM_THREADS` sets its size).
+/// Results equal the single queries', whatever the thread count. All points are
+/// checked first: on error nothing is written.
+#[no_mangle]
+pub unsafe extern "C" fn abgs_query_sizes(
+    grid: *const abgs_grid,
+    points: *const f64,
+    n: usize,
+    out_sizes: *mut f64,
+) -> abgs_status {
+    guard("abgs_query_sizes", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        // SAFETY: the caller guarantees n points and n outputs.
+        let (p, o) = unsafe { batch_args(points, n, out_sizes)? };
+        g.query_sizes(p, o)?;
+        Ok(())
+    })
+}
+
+/// Volume-mode size at `point`: `H(x) = min over surface points y of
+/// h(y) + ln(beta)·|x − y|`, the size a volume mesher should use inside the
+/// domain with gradation ratio `beta` (> 1, e.g. 1.2). Exact, by branch and bound.
+#[no_mangle]
+pub unsafe extern "C" fn abgs_query_size_volume(
+    grid: *const abgs_grid,
+    point: *const f64,
+    beta: f64,
+    out_size: *mut f64,
+) -> abgs_status {
+    guard("abgs_query_size_volume", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        // SAFETY: three doubles or NULL (checked).
+        let p = unsafe { point3(point, "point")? };
+        // SAFETY: writable or NULL (checked).
+        let o = unsafe { out(out_size, "out_size")? };
+        if !beta.is_finite() {
+            return err(abgs_status::ABGS_ERR_NON_FINITE, format!("beta = {beta}"));
+        }
+        *o = g.query_volume(p, beta)?.size;
+        Ok(())
+    })
+}
+
+/// Batch of volume-mode queries, in parallel (see `abgs_query_sizes`).
+#[no_mangle]
+pub unsafe extern "C" fn abgs_query_sizes_volume(
+    grid: *const abgs_grid,
+    points: *const f64,
+    n: usize,
+    beta: f64,
+    out_sizes: *mut f64,
+) -> abgs_status {
+    guard("abgs_query_sizes_volume", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        // SAFETY: the caller guarantees n points and n outputs.
+        let (p, o) = unsafe { batch_args(points, n, out_sizes)? };
+        if !beta.is_finite() {
+            return err(abgs_status::ABGS_ERR_NON_FINITE, format!("beta = {beta}"));
+        }
+        g.query_sizes_volume(p, beta, o)?;
+        Ok(())
+    })
+}
+
+/// Closest point, triangle, barycentric coordinates, distance and size at
+/// `point`; `hint` is a triangle index or `ABGS_NO_HINT`. Works without sizes
+/// (size is then NaN).
+#[no_mangle]
+pub unsafe extern "C" fn abgs_query_closest(
+    grid: *const abgs_grid,
+    point: *const f64,
+    hint: u32,
+    out_hit: *mut abgs_hit,
+) -> abgs_status {
+    guard("abgs_query_closest", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        // SAFETY: three doubles or NULL (checked).
+        let p = unsafe { point3(point, "point")? };
+        // SAFETY: writable or NULL (checked).
+        let o = unsafe { out(out_hit, "out_hit")? };
+        let h = g.closest(p, (hint != ABGS_NO_HINT).then_some(hint))?;
+        *o = abgs_hit {
+            triangle: h.triangle,
+            bary: h.bary,
+            point: h.point,
+            distance: h.distance,
+            size: h.size,
+        };
+        Ok(())
+    })
+}
+
+/// Views the batch arguments.
+///
+/// # Safety
+/// `points` must hold 3n doubles and `out_sizes` n writable doubles (or be NULL).
+unsafe fn batch_args<'a>(
+    points: *const f64,
+    n: usize,
+    out_sizes: *mut f64,
+) -> FfiResult<(&'a [[f64; 3]], &'a mut [f64])> {
+    if n > 0 && (points.is_null() || out_sizes.is_null()) {
+        return err(abgs_status::ABGS_ERR_NULL, "points or out_sizes is NULL");
+    }
+    // SAFETY: [f64; 3] has the layout and alignment of three doubles; n points by contract.
+    let p = unsafe { slice(points as *const [f64; 3], n, "points")? };
+    // SAFETY: n writable doubles by contract.
+    let o = unsafe { slice_mut(out_sizes, n, "out_sizes")? };
+    Ok((p, o))
+}

@@ -1,0 +1,436 @@
+//! The background grid: an immutable triangle surface with one size per vertex,
+//! its adjacency, its BVH and the report of what was found on input.
+
+mod stats;
+mod topology;
+mod validate;
+pub mod weld;
+
+pub use stats::{AngleStats, GridStats};
+pub use topology::Topology;
+pub use validate::ValidationReport;
+
+use crate::error::{Error, Result};
+use crate::geometry::Aabb;
+use crate::io::{Format, PointArray, SurfaceData};
+use crate::spatial::Bvh;
+use std::path::Path;
+
+/// How a grid is built from raw data.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BuildOptions {
+    /// Weld vertices closer than this fraction of the bounding-box diagonal;
+    /// `None` keeps the vertices as given (indices stay stable).
+    pub weld_relative_tolerance: Option<f64>,
+    /// Make triangle orientation consistent per body (outward when closed).
+    pub orient: bool,
+}
+
+impl Default for BuildOptions {
+    /// No welding, orientation fixed.
+    fn default() -> Self {
+        BuildOptions {
+            weld_relative_tolerance: None,
+            orient: true,
+        }
+    }
+}
+
+impl BuildOptions {
+    /// Default relative weld tolerance for triangle soups (STL): 1e-7 of the diagonal.
+    pub const SOUP_WELD_TOLERANCE: f64 = 1e-7;
+
+    /// Options suited to a file format: STL (a soup) is welded, indexed formats are not.
+    pub fn for_format(format: Format) -> BuildOptions {
+        BuildOptions {
+            weld_relative_tolerance: (format == Format::Stl).then_some(Self::SOUP_WELD_TOLERANCE),
+            orient: true,
+        }
+    }
+}
+
+/// A background grid. Immutable except for its sizes ([`Grid::set_sizes`]);
+/// any number of threads may query it at once.
+#[derive(Debug, Clone)]
+pub struct Grid {
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    sizes: Option<Vec<f64>>,
+    /// Lower bound of the size over each BVH node (for volume queries).
+    node_min_size: Vec<f64>,
+    extra: Vec<PointArray>,
+    topology: Topology,
+    bvh: Bvh,
+    bbox: Aabb,
+    report: ValidationReport,
+}
+
+impl Grid {
+    /// Builds a grid from vertices, triangles and optional per-vertex sizes.
+    ///
+    /// Errors on a non-finite coordinate, an out-of-range index, a size that is not
+    /// finite and > 0, a size array of the wrong length, or when no triangle is
+    /// left. Zero-area triangles are dropped and counted in [`Grid::report`].
+    /// O(F log F).
+    pub fn from_arrays(
+        vertices: Vec<[f64; 3]>,
+        triangles: Vec<[u32; 3]>,
+        sizes: Option<Vec<f64>>,
+        options: &BuildOptions,
+    ) -> Result<Grid> {
+        let mut point_data = Vec::new();
+        if let Some(s) = sizes {
+            point_data.push(PointArray {
+                name: "size".into(),
+                values: s,
+            });
+        }
+        Grid::from_surface(
+            SurfaceData {
+                vertices,
+                triangles,
+                point_data,
+            },
+            options,
+        )
+    }
+
+    /// Builds a grid from a [`SurfaceData`]; its point array `size`, if any,
+    /// becomes the sizes, other arrays are kept and written back on save.
+    pub fn from_surface(data: SurfaceData, options: &BuildOptions) -> Result<Grid> {
+        let SurfaceData {
+            mut vertices,
+            mut triangles,
+            mut point_data,
+        } = data;
+        if vertices.is_empty() || triangles.is_empty() {
+            return Err(Error::Empty(format!(
+                "{} vertices and {} triangles given",
+                vertices.len(),
+                triangles.len()
+            )));
+        }
+        validate::check_input(&vertices, &triangles)?;
+        for a in &point_data {
+            if a.values.len() != vertices.len() {
+                return Err(Error::InvalidArgument(format!(
+                    "array '{}' has {} values for {} vertices",
+                    a.name,
+                    a.values.len(),
+                    vertices.len()
+                )));
+            }
+        }
+        let sizes = match point_data.iter().position(|a| a.name == "size") {
+            Some(i) => {
+                let s = point_data.remove(i).values;
+                check_sizes(&s, vertices.len())?;
+                Some(s)
+            }
+            None => None,
+        };
+        let mut report = ValidationReport {
+            input_vertices: vertices.len(),
+            input_triangles: triangles.len(),
+            ..Default::default()
+        };
+        let bbox = Aabb::from_points(&vertices);
+        let mut sizes = sizes;
+        if let Some(rel) = options.weld_relative_tolerance {
+            if !(rel.is_finite() && rel >= 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "weld tolerance {rel} must be finite and >= 0"
+                )));
+            }
+            let (kept, remap) = weld::weld(&vertices, rel * bbox.diagonal());
+            report.welded_vertices = vertices.len() - kept.len();
+            if report.welded_vertices > 0 {
+                let pick = |vals: &[f64]| {
+                    let mut out = vec![f64::NAN; kept.len()];
+                    for (i, &r) in remap.iter().enumerate().rev() {
+                        out[r as usize] = vals[i];
+                    }
+                    out
+                };
+                sizes = sizes.map(|s| pick(&s));
+                for a in &mut point_data {
+                    a.values = pick(&a.values);
+                }
+                for t in &mut triangles {
+                    *t = t.map(|v| remap[v as usize]);
+                }
+                vertices = kept;
+            }
+        }
+        let (mut kept, repeated, zero) = validate::drop_degenerate(&vertices, &triangles);
+        report.dropped_repeated_index = repeated;
+        report.dropped_zero_area = zero;
+        if kept.is_empty() {
+            return Err(Error::Empty(format!(
+                "all {} triangles are degenerate",
+                triangles.len()
+            )));
+        }
+        let mut topology = Topology::build(vertices.len(), &kept);
+        if options.orient {
+            let (flipped, bad) = validate::orient(&vertices, &mut kept, &topology);
+            report.flipped_triangles = flipped;
+            report.non_orientable_bodies = bad;
+            if flipped > 0 {
+                topology = Topology::build(vertices.len(), &kept);
+            }
+        }
+        let triangles = kept;
+        report.duplicate_triangles = validate::count_duplicates(&triangles);
+        report.boundary_edges = topology.boundary_edge_count();
+        report.non_manifold_edges = topology.non_manifold_edge_count();
+        report.non_manifold_vertices =
+            validate::count_non_manifold_vertices(&topology, vertices.len());
+        report.bodies = topology.body_count as usize;
+        report.unreferenced_vertices = (0..vertices.len())
+            .filter(|&v| topology.faces_of_vertex(v).is_empty())
+            .count();
+        let mut open = vec![false; report.bodies];
+        for e in 0..topology.edges.len() {
+            let ef = topology.faces_of_edge(e);
+            if ef.len() == 1 {
+                open[topology.face_body[ef[0] as usize] as usize] = true;
+            }
+        }
+        report.open_bodies = open.iter().filter(|&&o| o).count();
+        report.sliver_triangles = stats::count_slivers(&vertices, &triangles, 1.0);
+        let bvh = Bvh::build(&vertices, &triangles);
+        let mut grid = Grid {
+            bbox: Aabb::from_points(&vertices),
+            vertices,
+            triangles,
+            sizes: None,
+            node_min_size: Vec::new(),
+            extra: point_data,
+            topology,
+            bvh,
+            report,
+        };
+        if let Some(s) = sizes {
+            grid.install_sizes(s);
+        }
+        Ok(grid)
+    }
+
+    /// Reads a grid from a file (format by extension). STL is welded with
+    /// [`BuildOptions::SOUP_WELD_TOLERANCE`]; a `size` point array becomes the sizes.
+    pub fn load(path: &Path) -> Result<Grid> {
+        let format = Format::from_path(path)?;
+        let data = crate::io::read(path)?;
+        Grid::from_surface(data, &BuildOptions::for_format(format))
+    }
+
+    /// Writes the grid (sizes as point array `size`, plus any other arrays read
+    /// with it) to `path`, format by extension.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        crate::io::write(path, &self.to_surface())
+    }
+
+    /// The grid as plain data (a copy), sizes first among the point arrays.
+    pub fn to_surface(&self) -> SurfaceData {
+        let mut point_data = Vec::new();
+        if let Some(s) = &self.sizes {
+            point_data.push(PointArray {
+                name: "size".into(),
+                values: s.clone(),
+            });
+        }
+        point_data.extend(self.extra.iter().cloned());
+        SurfaceData {
+            vertices: self.vertices.clone(),
+            triangles: self.triangles.clone(),
+            point_data,
+        }
+    }
+
+    /// Replaces the sizes (one per vertex, each finite and > 0). O(V + F).
+    pub fn set_sizes(&mut self, sizes: Vec<f64>) -> Result<()> {
+        check_sizes(&sizes, self.vertices.len())?;
+        self.install_sizes(sizes);
+        Ok(())
+    }
+
+    /// Removes the sizes.
+    pub fn clear_sizes(&mut self) {
+        self.sizes = None;
+        self.node_min_size.clear();
+    }
+
+    fn install_sizes(&mut self, sizes: Vec<f64>) {
+        let tri_min: Vec<f64> = self
+            .triangles
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&v| sizes[v as usize])
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect();
+        self.node_min_size = self.bvh.node_minima(&tri_min);
+        self.sizes = Some(sizes);
+    }
+
+    /// Adds (or replaces) a named per-vertex array kept alongside the grid and
+    /// written on save. The name `size` is reserved: use [`Grid::set_sizes`].
+    pub fn set_point_array(&mut self, name: &str, values: Vec<f64>) -> Result<()> {
+        if name == "size" {
+            return Err(Error::InvalidArgument(
+                "'size' is reserved; use set_sizes".into(),
+            ));
+        }
+        if values.len() != self.vertices.len() {
+            return Err(Error::InvalidArgument(format!(
+                "array '{name}' has {} values for {} vertices",
+                values.len(),
+                self.vertices.len()
+            )));
+        }
+        self.extra.retain(|a| a.name != name);
+        self.extra.push(PointArray {
+            name: name.into(),
+            values,
+        });
+        Ok(())
+    }
+
+    /// Vertex coordinates.
+    pub fn vertices(&self) -> &[[f64; 3]] {
+        &self.vertices
+    }
+    /// Triangles (vertex indices).
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+    /// Per-vertex sizes, if set.
+    pub fn sizes(&self) -> Option<&[f64]> {
+        self.sizes.as_deref()
+    }
+    /// Per-vertex arrays other than sizes.
+    pub fn point_arrays(&self) -> &[PointArray] {
+        &self.extra
+    }
+    /// Adjacency tables.
+    pub fn topology(&self) -> &Topology {
+        &self.topology
+    }
+    /// The spatial index.
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+    /// Per-node size lower bounds (empty without sizes).
+    pub(crate) fn node_min_size(&self) -> &[f64] {
+        &self.node_min_size
+    }
+    /// Bounding box of the vertices.
+    pub fn bbox(&self) -> Aabb {
+        self.bbox
+    }
+    /// What was found and repaired on input.
+    pub fn report(&self) -> &ValidationReport {
+        &self.report
+    }
+}
+
+/// Checks that `sizes` has `n` values, each finite and > 0.
+pub(crate) fn check_sizes(sizes: &[f64], n: usize) -> Result<()> {
+    if sizes.len() != n {
+        return Err(Error::InvalidArgument(format!(
+            "{} sizes given for {n} vertices",
+            sizes.len()
+        )));
+    }
+    if let Some(i) = sizes.iter().position(|&s| !(s.is_finite() && s > 0.0)) {
+        return Err(Error::InvalidSize(format!(
+            "size of vertex {i} is {} (must be finite and > 0)",
+            sizes[i]
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        (
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    #[test]
+    fn builds_and_reports() {
+        let (v, t) = square();
+        let g = Grid::from_arrays(v, t, Some(vec![1.0; 4]), &BuildOptions::default()).unwrap();
+        assert_eq!(g.report().boundary_edges, 4);
+        assert_eq!(g.report().bodies, 1);
+        assert_eq!(g.report().open_bodies, 1);
+        assert_eq!(g.topology().edges.len(), 5);
+        assert_eq!(g.sizes().unwrap().len(), 4);
+    }
+
+    #[test]
+    fn rejects_bad_input() {
+        let (v, t) = square();
+        let o = BuildOptions::default();
+        assert!(matches!(
+            Grid::from_arrays(v.clone(), vec![[0, 1, 7]], None, &o),
+            Err(Error::OutOfRange(_))
+        ));
+        let mut bad = v.clone();
+        bad[2][1] = f64::NAN;
+        assert!(matches!(
+            Grid::from_arrays(bad, t.clone(), None, &o),
+            Err(Error::NonFinite(_))
+        ));
+        assert!(matches!(
+            Grid::from_arrays(v.clone(), t.clone(), Some(vec![1.0, 0.0, 1.0, 1.0]), &o),
+            Err(Error::InvalidSize(_))
+        ));
+        assert!(matches!(
+            Grid::from_arrays(v.clone(), t.clone(), Some(vec![1.0; 3]), &o),
+            Err(Error::InvalidArgument(_))
+        ));
+        assert!(matches!(
+            Grid::from_arrays(v, vec![], None, &o),
+            Err(Error::Empty(_))
+        ));
+        let line = vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        assert!(matches!(
+            Grid::from_arrays(line, vec![[0, 1, 2]], None, &o),
+            Err(Error::Empty(_))
+        ));
+    }
+
+    #[test]
+    fn welds_soups_and_keeps_sizes() {
+        // Two triangles of a square as a soup.
+        let v = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let t = vec![[0, 1, 2], [3, 4, 5]];
+        let s = vec![1.0, 2.0, 3.0, 1.0, 3.0, 4.0];
+        let o = BuildOptions::for_format(Format::Stl);
+        let g = Grid::from_arrays(v, t, Some(s), &o).unwrap();
+        assert_eq!(g.vertices().len(), 4);
+        assert_eq!(g.report().welded_vertices, 2);
+        assert_eq!(g.sizes().unwrap(), &[1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(g.report().boundary_edges, 4);
+    }
+}

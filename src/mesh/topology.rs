@@ -1,0 +1,217 @@
+//! Adjacency of a triangle grid: unique edges, edge→faces, face→edges,
+//! vertex→faces, bodies (connected components), boundary and non-manifold edges.
+//!
+//! Everything is stored in flat compressed-sparse-row arrays, built in
+//! O(F log F) by one sort of the 3F half-edges. The result is deterministic.
+
+use rayon::prelude::*;
+
+/// Adjacency tables of a grid. Immutable once built.
+#[derive(Debug, Clone, Default)]
+pub struct Topology {
+    /// Unique undirected edges `[a, b]` with `a < b`, sorted.
+    pub edges: Vec<[u32; 2]>,
+    /// Faces of edge `e` are `edge_faces[edge_face_offsets[e]..edge_face_offsets[e + 1]]`.
+    pub edge_face_offsets: Vec<u32>,
+    /// Flat edge→face list (see `edge_face_offsets`), faces ascending per edge.
+    pub edge_faces: Vec<u32>,
+    /// The three edges of each face: edge `k` joins corners `k` and `(k + 1) % 3`.
+    pub face_edges: Vec<[u32; 3]>,
+    /// Faces around vertex `v` are `vertex_faces[vertex_face_offsets[v]..vertex_face_offsets[v + 1]]`.
+    pub vertex_face_offsets: Vec<u32>,
+    /// Flat vertex→face list, faces ascending per vertex.
+    pub vertex_faces: Vec<u32>,
+    /// Body (connected component through manifold edges) of each face, numbered
+    /// 0.. in order of each body's lowest face index.
+    pub face_body: Vec<u32>,
+    /// Number of bodies.
+    pub body_count: u32,
+}
+
+impl Topology {
+    /// Builds the tables for `triangles` over `vertex_count` vertices.
+    /// Triangles must reference valid vertices and have three distinct corners.
+    /// O(F log F) time, O(F) memory.
+    pub fn build(vertex_count: usize, triangles: &[[u32; 3]]) -> Topology {
+        // Half-edges keyed by (min, max, face, corner).
+        let mut half: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(triangles.len() * 3);
+        for (f, t) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                half.push((a.min(b), a.max(b), f as u32, k as u8));
+            }
+        }
+        half.par_sort_unstable();
+        let mut edges = Vec::new();
+        let mut edge_face_offsets = vec![0u32];
+        let mut edge_faces = Vec::with_capacity(half.len());
+        let mut face_edges = vec![[u32::MAX; 3]; triangles.len()];
+        let mut i = 0;
+        while i < half.len() {
+            let (a, b) = (half[i].0, half[i].1);
+            let e = edges.len() as u32;
+            edges.push([a, b]);
+            while i < half.len() && half[i].0 == a && half[i].1 == b {
+                let (f, k) = (half[i].2, half[i].3);
+                if edge_faces.len() as u32 == *edge_face_offsets.last().unwrap()
+                    || *edge_faces.last().unwrap() != f
+                {
+                    edge_faces.push(f);
+                }
+                face_edges[f as usize][k as usize] = e;
+                i += 1;
+            }
+            edge_face_offsets.push(edge_faces.len() as u32);
+        }
+
+        // vertex -> faces by counting sort.
+        let mut vertex_face_offsets = vec![0u32; vertex_count + 1];
+        for t in triangles {
+            for &v in t {
+                vertex_face_offsets[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertex_count {
+            vertex_face_offsets[v + 1] += vertex_face_offsets[v];
+        }
+        let mut fill = vertex_face_offsets.clone();
+        let mut vertex_faces = vec![0u32; triangles.len() * 3];
+        for (f, t) in triangles.iter().enumerate() {
+            for &v in t {
+                vertex_faces[fill[v as usize] as usize] = f as u32;
+                fill[v as usize] += 1;
+            }
+        }
+
+        let mut topo = Topology {
+            edges,
+            edge_face_offsets,
+            edge_faces,
+            face_edges,
+            vertex_face_offsets,
+            vertex_faces,
+            face_body: Vec::new(),
+            body_count: 0,
+        };
+        topo.label_bodies(triangles.len());
+        topo
+    }
+
+    /// Union-find over faces joined by manifold edges (exactly two faces).
+    fn label_bodies(&mut self, face_count: usize) {
+        let mut parent: Vec<u32> = (0..face_count as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                let g = p[p[x as usize] as usize];
+                p[x as usize] = g;
+                x = g;
+            }
+            x
+        }
+        for e in 0..self.edges.len() {
+            let fs = self.faces_of_edge(e);
+            if fs.len() == 2 {
+                let (ra, rb) = (find(&mut parent, fs[0]), find(&mut parent, fs[1]));
+                if ra != rb {
+                    let (lo, hi) = (ra.min(rb), ra.max(rb));
+                    parent[hi as usize] = lo;
+                }
+            }
+        }
+        let mut label = vec![u32::MAX; face_count];
+        let mut face_body = vec![0u32; face_count];
+        let mut count = 0;
+        for f in 0..face_count {
+            let r = find(&mut parent, f as u32) as usize;
+            if label[r] == u32::MAX {
+                label[r] = count;
+                count += 1;
+            }
+            face_body[f] = label[r];
+        }
+        self.face_body = face_body;
+        self.body_count = count;
+    }
+
+    /// Faces incident to edge `e`. O(1).
+    #[inline]
+    pub fn faces_of_edge(&self, e: usize) -> &[u32] {
+        let (s, t) = (self.edge_face_offsets[e], self.edge_face_offsets[e + 1]);
+        &self.edge_faces[s as usize..t as usize]
+    }
+
+    /// Faces incident to vertex `v`. O(1).
+    #[inline]
+    pub fn faces_of_vertex(&self, v: usize) -> &[u32] {
+        let (s, t) = (self.vertex_face_offsets[v], self.vertex_face_offsets[v + 1]);
+        &self.vertex_faces[s as usize..t as usize]
+    }
+
+    /// Number of edges with exactly one incident face.
+    pub fn boundary_edge_count(&self) -> usize {
+        (0..self.edges.len())
+            .filter(|&e| self.faces_of_edge(e).len() == 1)
+            .count()
+    }
+
+    /// Number of edges with more than two incident faces.
+    pub fn non_manifold_edge_count(&self) -> usize {
+        (0..self.edges.len())
+            .filter(|&e| self.faces_of_edge(e).len() > 2)
+            .count()
+    }
+
+    /// Index of edge `{a, b}` by binary search, if it exists. O(log E).
+    pub fn find_edge(&self, a: u32, b: u32) -> Option<usize> {
+        let key = [a.min(b), a.max(b)];
+        self.edges.binary_search(&key).ok()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two tetrahedra sharing nothing, plus a lone triangle.
+    fn sample() -> Vec<[u32; 3]> {
+        let tet = |o: u32| {
+            vec![
+                [o, o + 2, o + 1],
+                [o, o + 1, o + 3],
+                [o + 1, o + 2, o + 3],
+                [o, o + 3, o + 2],
+            ]
+        };
+        let mut t = tet(0);
+        t.extend(tet(4));
+        t.push([8, 9, 10]);
+        t
+    }
+
+    #[test]
+    fn counts_and_bodies() {
+        let t = sample();
+        let topo = Topology::build(11, &t);
+        assert_eq!(topo.edges.len(), 6 + 6 + 3);
+        assert_eq!(topo.boundary_edge_count(), 3);
+        assert_eq!(topo.non_manifold_edge_count(), 0);
+        assert_eq!(topo.body_count, 3);
+        assert_eq!(&topo.face_body[..5], &[0, 0, 0, 0, 1]);
+        assert_eq!(topo.faces_of_vertex(0), &[0, 1, 3]);
+        for (f, fe) in topo.face_edges.iter().enumerate() {
+            for &e in fe {
+                assert!(topo.faces_of_edge(e as usize).contains(&(f as u32)));
+            }
+        }
+        assert_eq!(topo.find_edge(3, 0), Some(topo.face_edges[1][2] as usize));
+    }
+
+    #[test]
+    fn non_manifold_edge_separates_bodies() {
+        // Three triangles on edge (0,1).
+        let t = vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]];
+        let topo = Topology::build(5, &t);
+        assert_eq!(topo.non_manifold_edge_count(), 1);
+        assert_eq!(topo.body_count, 3);
+    }
+}

@@ -1,0 +1,183 @@
+//! Size queries on a [`Grid`] (DESIGN §3.8).
+//!
+//! - **surface**: exact closest point on the grid, then barycentric interpolation
+//!   of the three vertex sizes of that triangle (never a mix across triangles or
+//!   bodies). Ties between equidistant triangles go to the lowest triangle index,
+//!   so the answer is a function of the point alone.
+//! - **hinted**: the same answer, with the search bound seeded by a triangle the
+//!   caller kept from a nearby query (advancing fronts query neighbours).
+//! - **batch**: many points in parallel (rayon), each answer identical to the
+//!   single query, whatever the thread count.
+//! - **volume**: `H(x) = min_y [h(y) + ln β · |x − y|]` over the surface, by branch
+//!   and bound (see [`volume`]).
+
+pub mod volume;
+
+use crate::error::{Error, Result};
+use crate::geometry::is_finite3;
+use crate::mesh::Grid;
+use rayon::prelude::*;
+
+pub use volume::VolumeHit;
+
+/// Answer of a surface query.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QueryHit {
+    /// Triangle holding the closest point (a good hint for the next query).
+    pub triangle: u32,
+    /// Barycentric coordinates of the closest point on that triangle.
+    pub bary: [f64; 3],
+    /// The closest point.
+    pub point: [f64; 3],
+    /// Distance from the query point to the surface.
+    pub distance: f64,
+    /// Interpolated size (NaN when the grid has no sizes).
+    pub size: f64,
+}
+
+/// Points per rayon task in batch queries; consecutive points share hints.
+const BATCH_CHUNK: usize = 256;
+
+impl Grid {
+    /// Closest point and interpolated size at `p`, with an optional triangle hint
+    /// (ignored when out of range). Errors only on a non-finite point.
+    /// Expected O(log F).
+    pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Result<QueryHit> {
+        if !is_finite3(p) {
+            return Err(Error::NonFinite(format!("query point {p:?}")));
+        }
+        let hit = self
+            .bvh()
+            .closest(p, hint)
+            .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
+        let t = self.triangles()[hit.triangle as usize];
+        let b = hit.closest.bary;
+        let size = match self.sizes() {
+            Some(s) => b[0] * s[t[0] as usize] + b[1] * s[t[1] as usize] + b[2] * s[t[2] as usize],
+            None => f64::NAN,
+        };
+        Ok(QueryHit {
+            triangle: hit.triangle,
+            bary: b,
+            point: hit.closest.point,
+            distance: hit.closest.dist2.sqrt(),
+            size,
+        })
+    }
+
+    /// Size at `p` (surface mode). Errors on a non-finite point or a grid without sizes.
+    pub fn query_size(&self, p: [f64; 3]) -> Result<f64> {
+        self.require_sizes()?;
+        Ok(self.closest(p, None)?.size)
+    }
+
+    /// Size at `p` with a hint: `*hint` is read (any value; `u32::MAX` = none) and
+    /// replaced by the triangle of the answer. The size is bit-identical to
+    /// [`Grid::query_size`].
+    pub fn query_size_hinted(&self, p: [f64; 3], hint: &mut u32) -> Result<f64> {
+        self.require_sizes()?;
+        let h = self.closest(p, Some(*hint))?;
+        *hint = h.triangle;
+        Ok(h.size)
+    }
+
+    /// Sizes at many points, in parallel; `out[i]` answers `points[i]`.
+    /// All points are checked first: on error nothing is written.
+    pub fn query_sizes(&self, points: &[[f64; 3]], out: &mut [f64]) -> Result<()> {
+        self.require_sizes()?;
+        check_batch(points, out.len())?;
+        points
+            .par_chunks(BATCH_CHUNK)
+            .zip(out.par_chunks_mut(BATCH_CHUNK))
+            .try_for_each(|(ps, os)| {
+                let mut hint = u32::MAX;
+                for (p, o) in ps.iter().zip(os.iter_mut()) {
+                    *o = self.query_size_hinted(*p, &mut hint)?;
+                }
+                Ok(())
+            })
+    }
+
+    pub(crate) fn require_sizes(&self) -> Result<()> {
+        if self.sizes().is_none() {
+            Err(Error::NoSizes)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Checks batch arguments: equal lengths and finite points.
+pub(crate) fn check_batch(points: &[[f64; 3]], out_len: usize) -> Result<()> {
+    if out_len != points.len() {
+        return Err(Error::InvalidArgument(format!(
+            "{} points but room for {out_len} results",
+            points.len()
+        )));
+    }
+    if let Some(i) = points.iter().position(|p| !is_finite3(*p)) {
+        return Err(Error::NonFinite(format!(
+            "query point {i} is {:?}",
+            points[i]
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::mesh::{BuildOptions, Grid};
+
+    fn plate() -> Grid {
+        let n = 10;
+        let mut v = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                v.push([i as f64 / n as f64, j as f64 / n as f64, 0.0]);
+            }
+        }
+        let mut t = Vec::new();
+        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        for j in 0..n {
+            for i in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let s = v.iter().map(|p| 1.0 + 2.0 * p[0] + 3.0 * p[1]).collect();
+        Grid::from_arrays(v, t, Some(s), &BuildOptions::default()).unwrap()
+    }
+
+    #[test]
+    fn linear_field_exact_and_hint_invariant() {
+        let g = plate();
+        let mut hint = u32::MAX;
+        for k in 0..100 {
+            let x = (k as f64 * 0.0137) % 1.0;
+            let y = (k as f64 * 0.0291) % 1.0;
+            let s = g.query_size([x, y, 0.3]).unwrap();
+            assert!((s - (1.0 + 2.0 * x + 3.0 * y)).abs() < 1e-12);
+            assert_eq!(g.query_size_hinted([x, y, 0.3], &mut hint).unwrap(), s);
+        }
+        let far = g.query_size([5.0, 0.5, 0.0]).unwrap();
+        assert!(
+            (far - (1.0 + 2.0 + 1.5)).abs() < 1e-12,
+            "clamped to the boundary"
+        );
+        assert!(g.query_size([f64::NAN, 0.0, 0.0]).is_err());
+    }
+
+    #[test]
+    fn batch_equals_single() {
+        let g = plate();
+        let pts: Vec<[f64; 3]> = (0..2000)
+            .map(|k| [(k as f64 * 0.37) % 1.3, (k as f64 * 0.11) % 1.1, 0.1])
+            .collect();
+        let mut out = vec![0.0; pts.len()];
+        g.query_sizes(&pts, &mut out).unwrap();
+        for (p, o) in pts.iter().zip(&out) {
+            assert_eq!(*o, g.query_size(*p).unwrap());
+        }
+        assert!(g.query_sizes(&pts, &mut out[1..]).is_err());
+    }
+}
