@@ -2,8 +2,9 @@
 #
 # Compatibility is SameMajorVersion-style, except that while the major version
 # is 0 a minor bump is a breaking change: 0.1.x satisfies a request for 0.1 or
-# 0.1.y (y <= x) but not 0.2; 1.x satisfies any 1.y (y <= x). Version ranges
-# (find_package(abgs 0.1...0.3)) are honoured as written.
+# 0.1.y (y <= x) but neither 0.2 nor 0.0 (a bare `0` accepts any 0.x); 1.x
+# satisfies any 1.y (y <= x). Version ranges (find_package(abgs 0.1...0.3)) are
+# honoured as written.
 #
 # In the source tree the version is read from Cargo.toml's [workspace.package]
 # `version`; scripts/install.sh hard-codes it on the next line when installing.
@@ -65,7 +66,7 @@ elseif(PACKAGE_VERSION VERSION_LESS PACKAGE_FIND_VERSION)
 elseif(NOT PACKAGE_FIND_VERSION_MAJOR STREQUAL _abgs_major)
   set(PACKAGE_VERSION_COMPATIBLE FALSE)
 elseif(_abgs_major STREQUAL "0"
-       AND NOT "${PACKAGE_FIND_VERSION_MINOR}" STREQUAL ""
+       AND PACKAGE_FIND_VERSION_COUNT GREATER 1
        AND NOT PACKAGE_FIND_VERSION_MINOR EQUAL _abgs_minor)
   # 0.x: the minor version is the breaking one.
   set(PACKAGE_VERSION_COMPATIBLE FALSE)

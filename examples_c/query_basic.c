@@ -62,7 +62,7 @@ int main(int argc, char **argv) {
     size_t n_points = 0;
 
     abgs_grid_stats stats;
-    if (!check(abgs_grid_stats(grid, &stats), "abgs_grid_stats")) {
+    if (!check(abgs_grid_get_stats(grid, &stats), "abgs_grid_get_stats")) {
         goto done;
     }
     printf("abgs %s, grid %s\n", abgs_version(), argv[1]);

@@ -150,6 +150,10 @@ uint32_t abgs_version_number(void);
 //
 // Errors: NULL, NON_FINITE (a coordinate), OUT_OF_RANGE (an index),
 // INVALID_SIZE, EMPTY (no triangle left), INVALID_ARGUMENT (counts too large).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_from_arrays(const double *xyz,
                                   size_t n_vertices,
                                   const uint32_t *triangles,
@@ -163,53 +167,101 @@ abgs_status abgs_grid_from_arrays(const double *xyz,
 //
 // Errors: NULL, IO, PARSE, UNSUPPORTED_FORMAT, NON_FINITE, OUT_OF_RANGE,
 // INVALID_SIZE, EMPTY.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_load(const char *path, abgs_grid **out_grid);
 
 // Writes the grid (with sizes as point data `size`) to a file, format by
 // extension: vtk (ParaView), msh (Gmsh background field), mesh (+ .sol for
 // MMG), vtu, ply, obj, off, stl.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_save(const abgs_grid *grid, const char *path);
 
 // Replaces the sizes: `n` must equal the vertex count, each value finite and > 0.
 // Returns BUSY if another call is using the grid. O(V + F).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_set_sizes(abgs_grid *grid, const double *sizes, size_t n);
 
 // Fills `*out_stats`. O(V) (size range).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_get_stats(const abgs_grid *grid, abgs_grid_stats *out_stats);
 
 // Number of vertices into `*out_count`.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_vertex_count(const abgs_grid *grid, size_t *out_count);
 
 // Number of triangles into `*out_count`.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_triangle_count(const abgs_grid *grid, size_t *out_count);
 
 // Copies the vertex coordinates (x0 y0 z0 x1 ...) into `out_xyz`, which holds
 // `capacity` doubles (at least 3 × vertex count, else BUFFER_TOO_SMALL).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_copy_vertices(const abgs_grid *grid, double *out_xyz, size_t capacity);
 
 // Copies the triangles (3 indices each) into `out_triangles`, which holds
 // `capacity` indices (at least 3 × triangle count).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_copy_triangles(const abgs_grid *grid,
                                      uint32_t *out_triangles,
                                      size_t capacity);
 
 // Copies the sizes (one per vertex) into `out_sizes` (`capacity` ≥ vertex count).
 // NO_SIZES when the grid has none.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_copy_sizes(const abgs_grid *grid, double *out_sizes, size_t capacity);
 
 // Releases a grid. NULL is accepted and ignored. Returns BUSY (and frees
 // nothing) if another call is still using the grid.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_free(abgs_grid *grid);
 
 // Size at `point` (3 doubles): exact closest point on the grid, barycentric
 // interpolation there. Expected O(log F).
 // Errors: NULL, NON_FINITE, NO_SIZES, BUSY (a mutation is running).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_query_size(const abgs_grid *grid, const double *point, double *out_size);
 
 // As `abgs_query_size`, seeded by `*hint` (a triangle index from an earlier
 // query, or `ABGS_NO_HINT`; any value is safe) and updating it to the triangle
 // of this answer. The size equals `abgs_query_size`'s bit for bit; only the time
 // changes (coherent queries, as an advancing front makes, are much faster).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_query_size_hinted(const abgs_grid *grid,
                                    const double *point,
                                    uint32_t *hint,
@@ -219,6 +271,10 @@ abgs_status abgs_query_size_hinted(const abgs_grid *grid,
 // in parallel on the rayon thread pool (`RAYON_NUM_THREADS` sets its size).
 // Results equal the single queries', whatever the thread count. All points are
 // checked first: on error nothing is written.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_query_sizes(const abgs_grid *grid,
                              const double *points,
                              size_t n,
@@ -227,12 +283,20 @@ abgs_status abgs_query_sizes(const abgs_grid *grid,
 // Volume-mode size at `point`: `H(x) = min over surface points y of
 // h(y) + ln(beta)·|x − y|`, the size a volume mesher should use inside the
 // domain with gradation ratio `beta` (> 1, e.g. 1.2). Exact, by branch and bound.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_query_size_volume(const abgs_grid *grid,
                                    const double *point,
                                    double beta,
                                    double *out_size);
 
 // Batch of volume-mode queries, in parallel (see `abgs_query_sizes`).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_query_sizes_volume(const abgs_grid *grid,
                                     const double *points,
                                     size_t n,
@@ -242,6 +306,10 @@ abgs_status abgs_query_sizes_volume(const abgs_grid *grid,
 // Closest point, triangle, barycentric coordinates, distance and size at
 // `point`; `hint` is a triangle index or `ABGS_NO_HINT`. Works without sizes
 // (size is then NaN).
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+// number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_query_closest(const abgs_grid *grid,
                                const double *point,
                                uint32_t hint,

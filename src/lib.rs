@@ -13,8 +13,11 @@
 //! - [`io`]: readers and writers for the supported file formats.
 //! - [`spatial`]: the bounding-volume hierarchy over triangles.
 //! - [`query`]: surface, hinted, batch and volume size queries.
+//! - [`sampling`]: deterministic point sets on and around a grid.
 //! - [`ffi`]: the C ABI.
 #![deny(missing_docs)]
+// Index loops over x, y, z read better than zipped iterators in geometry code.
+#![allow(clippy::needless_range_loop)]
 
 pub mod error;
 pub mod ffi;
@@ -22,6 +25,7 @@ pub mod geometry;
 pub mod io;
 pub mod mesh;
 pub mod query;
+pub mod sampling;
 pub mod spatial;
 
 pub use error::{Error, Result};

@@ -140,7 +140,7 @@ pub(crate) unsafe fn slice<'a, T>(p: *const T, len: usize, what: &str) -> FfiRes
     if p.is_null() {
         return err(abgs_status::ABGS_ERR_NULL, format!("{what} is NULL"));
     }
-    if (p as usize) % std::mem::align_of::<T>() != 0 {
+    if !(p as usize).is_multiple_of(std::mem::align_of::<T>()) {
         return err(
             abgs_status::ABGS_ERR_INVALID_ARGUMENT,
             format!("{what} is misaligned"),

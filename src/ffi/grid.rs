@@ -101,6 +101,10 @@ pub struct abgs_grid_stats {
 ///
 /// Errors: NULL, NON_FINITE (a coordinate), OUT_OF_RANGE (an index),
 /// INVALID_SIZE, EMPTY (no triangle left), INVALID_ARGUMENT (counts too large).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_from_arrays(
     xyz: *const f64,
@@ -162,6 +166,10 @@ pub unsafe extern "C" fn abgs_grid_from_arrays(
 ///
 /// Errors: NULL, IO, PARSE, UNSUPPORTED_FORMAT, NON_FINITE, OUT_OF_RANGE,
 /// INVALID_SIZE, EMPTY.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_load(
     path: *const c_char,
@@ -181,6 +189,10 @@ pub unsafe extern "C" fn abgs_grid_load(
 /// Writes the grid (with sizes as point data `size`) to a file, format by
 /// extension: vtk (ParaView), msh (Gmsh background field), mesh (+ .sol for
 /// MMG), vtu, ply, obj, off, stl.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_save(
     grid: *const abgs_grid,
@@ -198,6 +210,10 @@ pub unsafe extern "C" fn abgs_grid_save(
 
 /// Replaces the sizes: `n` must equal the vertex count, each value finite and > 0.
 /// Returns BUSY if another call is using the grid. O(V + F).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_set_sizes(
     grid: *mut abgs_grid,
@@ -218,6 +234,10 @@ pub unsafe extern "C" fn abgs_grid_set_sizes(
 }
 
 /// Fills `*out_stats`. O(V) (size range).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_get_stats(
     grid: *const abgs_grid,
@@ -262,6 +282,10 @@ pub unsafe extern "C" fn abgs_grid_get_stats(
 }
 
 /// Number of vertices into `*out_count`.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_vertex_count(
     grid: *const abgs_grid,
@@ -277,6 +301,10 @@ pub unsafe extern "C" fn abgs_grid_vertex_count(
 }
 
 /// Number of triangles into `*out_count`.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_triangle_count(
     grid: *const abgs_grid,
@@ -293,6 +321,10 @@ pub unsafe extern "C" fn abgs_grid_triangle_count(
 
 /// Copies the vertex coordinates (x0 y0 z0 x1 ...) into `out_xyz`, which holds
 /// `capacity` doubles (at least 3 × vertex count, else BUFFER_TOO_SMALL).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_copy_vertices(
     grid: *const abgs_grid,
@@ -313,6 +345,10 @@ pub unsafe extern "C" fn abgs_grid_copy_vertices(
 
 /// Copies the triangles (3 indices each) into `out_triangles`, which holds
 /// `capacity` indices (at least 3 × triangle count).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_copy_triangles(
     grid: *const abgs_grid,
@@ -333,6 +369,10 @@ pub unsafe extern "C" fn abgs_grid_copy_triangles(
 
 /// Copies the sizes (one per vertex) into `out_sizes` (`capacity` ≥ vertex count).
 /// NO_SIZES when the grid has none.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_copy_sizes(
     grid: *const abgs_grid,
@@ -353,6 +393,10 @@ pub unsafe extern "C" fn abgs_grid_copy_sizes(
 
 /// Releases a grid. NULL is accepted and ignored. Returns BUSY (and frees
 /// nothing) if another call is still using the grid.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_free(grid: *mut abgs_grid) -> abgs_status {
     guard("abgs_grid_free", || {

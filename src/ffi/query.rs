@@ -22,6 +22,10 @@ pub struct abgs_hit {
 /// Size at `point` (3 doubles): exact closest point on the grid, barycentric
 /// interpolation there. Expected O(log F).
 /// Errors: NULL, NON_FINITE, NO_SIZES, BUSY (a mutation is running).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_query_size(
     grid: *const abgs_grid,
@@ -44,6 +48,10 @@ pub unsafe extern "C" fn abgs_query_size(
 /// query, or `ABGS_NO_HINT`; any value is safe) and updating it to the triangle
 /// of this answer. The size equals `abgs_query_size`'s bit for bit; only the time
 /// changes (coherent queries, as an advancing front makes, are much faster).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_query_size_hinted(
     grid: *const abgs_grid,
@@ -69,6 +77,10 @@ pub unsafe extern "C" fn abgs_query_size_hinted(
 /// in parallel on the rayon thread pool (`RAYON_NUM_THREADS` sets its size).
 /// Results equal the single queries', whatever the thread count. All points are
 /// checked first: on error nothing is written.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_query_sizes(
     grid: *const abgs_grid,
@@ -89,6 +101,10 @@ pub unsafe extern "C" fn abgs_query_sizes(
 /// Volume-mode size at `point`: `H(x) = min over surface points y of
 /// h(y) + ln(beta)·|x − y|`, the size a volume mesher should use inside the
 /// domain with gradation ratio `beta` (> 1, e.g. 1.2). Exact, by branch and bound.
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_query_size_volume(
     grid: *const abgs_grid,
@@ -112,6 +128,10 @@ pub unsafe extern "C" fn abgs_query_size_volume(
 }
 
 /// Batch of volume-mode queries, in parallel (see `abgs_query_sizes`).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_query_sizes_volume(
     grid: *const abgs_grid,
@@ -136,6 +156,10 @@ pub unsafe extern "C" fn abgs_query_sizes_volume(
 /// Closest point, triangle, barycentric coordinates, distance and size at
 /// `point`; `hint` is a triangle index or `ABGS_NO_HINT`. Works without sizes
 /// (size is then NaN).
+///
+/// # Safety
+/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
+/// number of elements; a grid pointer comes from this library and is not freed.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_query_closest(
     grid: *const abgs_grid,

@@ -104,7 +104,7 @@ fn parse_mesh(path: &Path, bytes: &[u8]) -> Result<SurfaceData> {
                         *v = lx.parse::<u64>("a vertex index")?;
                     }
                     lx.parse::<i64>("an element reference")?;
-                    faces.push((f, lx.line()));
+                    faces.push((f, lx.token_line()));
                 }
                 lx.token()
             }

@@ -96,11 +96,13 @@ impl Format {
             "vtk" => Format::Vtk,
             "vtu" => Format::Vtu,
             "mesh" => Format::Medit,
-            _ => return Err(Error::UnsupportedFormat(format!(
+            _ => {
+                return Err(Error::UnsupportedFormat(format!(
                 "'{}': unknown extension '{}' (expected stl, obj, off, ply, msh, vtk, vtu or mesh)",
                 path.display(),
                 ext
-            ))),
+            )))
+            }
         })
     }
 }

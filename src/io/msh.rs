@@ -1,28 +1,29 @@
 //! Gmsh MSH (`.msh`), ASCII, hand-written.
 //!
 //! (`mshio` 0.4.2 was tried and dropped: it panics on malformed headers, e.g. an
-//! over-long data-size field or an odd binary size_t width, it cannot skip parametric
-//! node coordinates, and it does not read `$NodeData` anyway.)
+//! over-long data-size field or an odd binary size_t width, it rejects parametric
+//! nodes, and it does not read `$NodeData` anyway.)
 //!
 //! Reading accepts ASCII MSH 4.1 and 2.2 (binary files are rejected with a parse
 //! error). Nodes become vertices in file order; triangles are the elements of type 2
 //! and, by their three corner nodes, the higher-order triangle types (9, 20-25);
-//! other elements and unknown sections are skipped. Every scalar (1-component)
-//! `$NodeData` view becomes a point array named by its first string tag (a later
-//! view of the same name, e.g. a later time step, replaces an earlier one; an
-//! unnamed view is called `viewK`); when no array is called `size` and there is
-//! exactly one scalar view, that view is renamed `size`. Nodes a view does not cover
-//! get NaN.
+//! other elements and unknown sections are skipped. A node or element tag met again
+//! (Gmsh repeats the mesh when a view is saved with it) keeps its first definition.
+//! Every scalar (1-component) `$NodeData` view becomes a point array named by its
+//! first string tag (a later view of the same name, e.g. a later time step, replaces
+//! an earlier one; an unnamed view is called `viewK`); when that leaves exactly one
+//! array and it is not called `size`, it is renamed `size`. Nodes a view does not
+//! cover get NaN.
 //!
 //! Writing produces ASCII MSH 4.1: `$MeshFormat`, `$Nodes` (one entity block, dim 2,
 //! tag 1, node tags 1..n), `$Elements` (one block of type 2) and one `$NodeData` per
-//! point array (string tag = array name, time 0, step 0, 1 component), which Gmsh can
-//! `Merge` and use as a post-processing view (e.g. a background field).
+//! point array (string tag = array name, time 0, step 0, 1 component), which Gmsh
+//! 4.x merges as a post-processing view usable as a `PostView` background field.
 
 use super::off::{capacity, check_triangles, clip, create, finish, Lexer, Real};
 use super::{PointArray, SurfaceData};
 use crate::error::{Error, Result};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::io::Write;
 use std::path::Path;
 
@@ -77,6 +78,7 @@ struct Msh {
     vertices: Vec<[f64; 3]>,
     tags: HashMap<u64, u32>,
     elems: Vec<([u64; 3], usize)>,
+    elem_tags: HashSet<u64>,
     views: Vec<View>,
 }
 
@@ -137,12 +139,14 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<SurfaceData> {
     finish_mesh(path, m)
 }
 
+/// Adds a node; a tag seen before (Gmsh repeats the mesh when a view is saved
+/// with it) keeps its first definition.
 fn add_node(lx: &Lexer<'_>, m: &mut Msh, tag: u64, p: [f64; 3]) -> Result<()> {
     let idx = u32::try_from(m.vertices.len()).map_err(|_| lx.err("too many nodes"))?;
-    if m.tags.insert(tag, idx).is_some() {
-        return Err(lx.err(format!("duplicate node tag {tag}")));
+    if let std::collections::hash_map::Entry::Vacant(e) = m.tags.entry(tag) {
+        e.insert(idx);
+        m.vertices.push(p);
     }
-    m.vertices.push(p);
     Ok(())
 }
 
@@ -159,7 +163,7 @@ fn nodes_v4(lx: &mut Lexer<'_>, m: &mut Msh) -> Result<()> {
     let total = lx.count("the number of nodes")?;
     lx.parse::<u64>("the minimum node tag")?;
     lx.parse::<u64>("the maximum node tag")?;
-    let before = m.vertices.len();
+    let mut read = 0usize;
     m.vertices.reserve(capacity(total, lx.remaining(), 8));
     let mut tags = Vec::new();
     for _ in 0..blocks {
@@ -183,12 +187,10 @@ fn nodes_v4(lx: &mut Lexer<'_>, m: &mut Msh) -> Result<()> {
             }
             add_node(lx, m, tag, p)?;
         }
+        read += n;
     }
-    if m.vertices.len() - before != total {
-        return Err(lx.err(format!(
-            "$Nodes announces {total} nodes but holds {}",
-            m.vertices.len() - before
-        )));
+    if read != total {
+        return Err(lx.err(format!("$Nodes announces {total} nodes but holds {read}")));
     }
     Ok(())
 }
@@ -204,19 +206,20 @@ fn nodes_v2(lx: &mut Lexer<'_>, m: &mut Msh) -> Result<()> {
     Ok(())
 }
 
-/// Reads one element of type `etype` after its tag (and v2 tags), keeping triangles.
-fn element_nodes(lx: &mut Lexer<'_>, m: &mut Msh, etype: u32) -> Result<()> {
+/// Reads the nodes of element `tag` of type `etype`, keeping triangles (once per
+/// element tag, as Gmsh may repeat the mesh in a file).
+fn element_nodes(lx: &mut Lexer<'_>, m: &mut Msh, tag: u64, etype: u32) -> Result<()> {
     match nodes_of(etype) {
         Some(k) => {
             let mut t = [0u64; 3];
             for j in 0..k {
                 let tag = lx.parse::<u64>("a node tag")?;
-                if j < 3 {
-                    t[j] = tag;
+                if let Some(slot) = t.get_mut(j) {
+                    *slot = tag;
                 }
             }
-            if is_triangle(etype) {
-                m.elems.push((t, lx.line()));
+            if is_triangle(etype) && m.elem_tags.insert(tag) {
+                m.elems.push((t, lx.token_line()));
             }
         }
         None => {
@@ -252,20 +255,20 @@ fn elements(lx: &mut Lexer<'_>, m: &mut Msh) -> Result<()> {
                 m.elems.reserve(capacity(n, lx.remaining(), 8));
             }
             for _ in 0..n {
-                lx.parse::<u64>("an element tag")?;
-                element_nodes(lx, m, etype)?;
+                let tag = lx.parse::<u64>("an element tag")?;
+                element_nodes(lx, m, tag, etype)?;
             }
         }
     } else {
         let n = lx.count("the number of elements")?;
         for _ in 0..n {
-            lx.parse::<u64>("an element tag")?;
+            let tag = lx.parse::<u64>("an element tag")?;
             let etype = lx.parse::<u32>("the element type")?;
             let ntags = lx.count("the number of element tags")?;
             for _ in 0..ntags {
                 lx.parse::<i64>("an element tag")?;
             }
-            element_nodes(lx, m, etype)?;
+            element_nodes(lx, m, tag, etype)?;
         }
     }
     Ok(())
@@ -273,7 +276,7 @@ fn elements(lx: &mut Lexer<'_>, m: &mut Msh) -> Result<()> {
 
 fn node_data(lx: &mut Lexer<'_>, m: &mut Msh) -> Result<()> {
     let nstr = lx.count("the number of string tags")?;
-    let line = lx.line();
+    let line = lx.token_line();
     lx.rest_of_line();
     let mut name = None;
     for _ in 0..nstr {
@@ -458,6 +461,9 @@ mod tests {
         assert_eq!(d.vertices[3], [1.0, 1.0, 0.0]);
         assert_eq!(d.triangles, vec![[0, 1, 2], [1, 3, 2]]);
         assert!(d.point_data.is_empty());
+        // Gmsh repeats the mesh when saving a view with it: read it once.
+        let twice = format!("{text}{text}");
+        assert_eq!(parse(Path::new("x.msh"), twice.as_bytes()).unwrap(), d);
     }
 
     #[test]
@@ -477,7 +483,7 @@ mod tests {
             format!("{head}{nodes}$Elements\n1 1 1 1\n2 1 2 1\n1 1 2\n$EndElements\n"),
             format!("{head}{nodes}$NodeData\n1\n\"size\"\n1\n0\n3\n0\n1\n1\n7 1.0\n$EndNodeData\n"),
             format!("{head}{nodes}$NodeData\n1\n\"size\"\n1\n0\n3\n0\n1\n2\n1 x\n$EndNodeData\n"),
-            format!("{head}$Nodes\n1 2 1 2\n2 1 0 2\n1\n1\n0 0 0\n1 0 0\n$EndNodes\n"),
+            format!("{head}$Nodes\n1 2 1 2\n2 1 0 3\n1\n1\n0 0 0\n1 0 0\n$EndNodes\n"),
             format!("{head}$Comments\nno end\n"),
         ] {
             assert!(parse(p, text.as_bytes()).is_err(), "{text:?}");

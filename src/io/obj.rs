@@ -188,7 +188,7 @@ mod tests {
     fn shared_rocker_arm() {
         if let Some(p) = shared_mesh("ajc_rocker_arm.obj") {
             let d = read(&p).unwrap();
-            assert!(!d.triangles.is_empty());
+            assert_eq!((d.vertices.len(), d.triangles.len()), (10044, 20088));
             let n = d.vertices.len() as u32;
             assert!(d.triangles.iter().flatten().all(|&v| v < n));
         }

@@ -11,7 +11,8 @@
 use super::off::{check_triangles, create, finish};
 use super::SurfaceData;
 use crate::error::{Error, Result};
-use std::io::Cursor;
+use std::fs::OpenOptions;
+use std::io::{Cursor, Write};
 use std::path::Path;
 use stl_io::{Normal, Triangle, Vertex};
 
@@ -141,8 +142,20 @@ pub(crate) fn write(path: &Path, data: &SurfaceData) -> Result<()> {
     });
     let mut w = create(path)?;
     stl_io::write_stl(&mut w, facets).map_err(|e| Error::io(path, e))?;
-    finish(path, w)
+    finish(path, w)?;
+    // stl_io writes an all-zero header, which Gmsh refuses: name the writer instead
+    // (never starting with "solid", which would suggest ASCII).
+    let mut header = [b' '; 80];
+    header[..HEADER.len()].copy_from_slice(HEADER);
+    OpenOptions::new()
+        .write(true)
+        .open(path)
+        .and_then(|mut f| f.write_all(&header))
+        .map_err(|e| Error::io(path, e))
 }
+
+/// The start of the 80-byte header of written binary STL files.
+const HEADER: &[u8] = b"binary STL written by abgs";
 
 #[cfg(test)]
 mod tests {
@@ -158,8 +171,8 @@ mod tests {
         assert_eq!(r.triangles.len(), d.triangles.len());
         assert_eq!(r.vertices.len(), 3 * d.triangles.len());
         for (k, t) in d.triangles.iter().enumerate() {
-            for j in 0..3 {
-                let want = d.vertices[t[j] as usize].map(|x| x as f32 as f64);
+            for (j, &v) in t.iter().enumerate() {
+                let want = d.vertices[v as usize].map(|x| x as f32 as f64);
                 assert_eq!(r.vertices[3 * k + j], want);
             }
             assert_eq!(
@@ -168,6 +181,7 @@ mod tests {
             );
         }
         assert!(r.point_data.is_empty());
+        assert!(std::fs::read(&t.0).unwrap().starts_with(HEADER));
     }
 
     const ASCII: &str = "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n\
@@ -206,7 +220,7 @@ mod tests {
             truncated,
             huge,
             ASCII.replace("vertex 1 0 0", "vertex 1 x 0").into_bytes(),
-            ASCII[..60].as_bytes().to_vec(),
+            ASCII.as_bytes()[..60].to_vec(),
         ] {
             assert!(parse(p, bytes.clone()).is_err(), "{bytes:?}");
         }
@@ -216,7 +230,7 @@ mod tests {
     fn shared_hinge() {
         if let Some(p) = shared_mesh("netgen_hinge.stl") {
             let d = read(&p).unwrap();
-            assert!(!d.triangles.is_empty());
+            assert_eq!(d.triangles.len(), 1212);
             assert_eq!(d.vertices.len(), 3 * d.triangles.len());
         }
     }

@@ -1,0 +1,27 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+/// The third-party models folder (`../shared/meshes` beside the checkout).
+/// Returns `None` (and says so) when it is absent outside CI; in CI it must exist.
+pub fn shared_meshes() -> Option<PathBuf> {
+    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"));
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    if std::env::var_os("CI").is_some() {
+        panic!("{} is missing: CI must provide ../shared", dir.display());
+    }
+    eprintln!("skipping: {} not found", dir.display());
+    None
+}
+
+/// A positive linear field a·x + b·y + c·z + d over the grid's bounding box.
+pub fn linear_field(bmin: [f64; 3], diag: f64) -> impl Fn([f64; 3]) -> f64 + Sync {
+    move |p: [f64; 3]| {
+        0.05 * diag + 0.3 * (p[0] - bmin[0]) - 0.2 * (p[1] - bmin[1])
+            + 0.1 * (p[2] - bmin[2])
+            + 0.2 * diag
+    }
+}
