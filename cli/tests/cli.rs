@@ -16,7 +16,12 @@ fn tmp(name: &str) -> PathBuf {
 /// A small grid with sizes, written as VTK.
 fn sized_grid(tag: &str) -> PathBuf {
     let path = tmp(&format!("plate-{tag}.vtk"));
-    let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+    let v = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ];
     let t = vec![[0, 1, 2], [0, 2, 3]];
     let s = v.iter().map(|p| 0.1 + p[0] + 2.0 * p[1]).collect();
     let g = abgs::Grid::from_arrays(v, t, Some(s), &abgs::BuildOptions::default()).unwrap();
@@ -26,15 +31,28 @@ fn sized_grid(tag: &str) -> PathBuf {
 
 #[test]
 fn info_reports_counts_and_defects() {
-    let out = abgs().arg("info").arg(sized_grid("info1")).arg("--json").output().unwrap();
+    let out = abgs()
+        .arg("info")
+        .arg(sized_grid("info1"))
+        .arg("--json")
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["vertices"], 4);
     assert_eq!(v["triangles"], 2);
     assert_eq!(v["boundary_edges"], 4);
     assert_eq!(v["sizes"]["max"], 3.1);
-    assert!(v["defects"].as_array().unwrap().iter().any(|d| d.as_str().unwrap().contains("boundary")));
-    let text = abgs().arg("info").arg(sized_grid("info2")).output().unwrap();
+    assert!(v["defects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|d| d.as_str().unwrap().contains("boundary")));
+    let text = abgs()
+        .arg("info")
+        .arg(sized_grid("info2"))
+        .output()
+        .unwrap();
     assert!(String::from_utf8_lossy(&text.stdout).contains("bytes/triangle"));
 }
 
@@ -43,17 +61,40 @@ fn query_answers_in_order_in_both_modes() {
     let grid = sized_grid("query");
     let pts = tmp("pts.txt"); // only this test uses it
     std::fs::write(&pts, "# x y z\n0.5 0.25 0\n\n1,1,1\n0 0 -2\n").unwrap();
-    let out = abgs().args(["query"]).arg(&grid).arg("--points").arg(&pts).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let vals: Vec<f64> = String::from_utf8_lossy(&out.stdout).lines().map(|l| l.parse().unwrap()).collect();
+    let out = abgs()
+        .args(["query"])
+        .arg(&grid)
+        .arg("--points")
+        .arg(&pts)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let vals: Vec<f64> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
     let expect = [0.1 + 0.5 + 0.5, 0.1 + 1.0 + 2.0, 0.1];
     assert_eq!(vals.len(), 3);
     for (a, b) in vals.iter().zip(expect) {
         assert!((a - b).abs() < 1e-12, "{a} vs {b}");
     }
-    let out = abgs().args(["query"]).arg(&grid).arg("--points").arg(&pts).args(["--mode", "volume", "--beta", "1.5"]).output().unwrap();
+    let out = abgs()
+        .args(["query"])
+        .arg(&grid)
+        .arg("--points")
+        .arg(&pts)
+        .args(["--mode", "volume", "--beta", "1.5"])
+        .output()
+        .unwrap();
     assert!(out.status.success());
-    let vol: Vec<f64> = String::from_utf8_lossy(&out.stdout).lines().map(|l| l.parse().unwrap()).collect();
+    let vol: Vec<f64> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
     // The corner (0,0,-2) is 2 away from the size-0.1 vertex: H <= 0.1 + ln(1.5)·2.
     assert!(vol[2] <= 0.1 + 1.5f64.ln() * 2.0 + 1e-12 && vol[2] > 0.1);
 }
@@ -63,29 +104,55 @@ fn convert_round_trips_sizes() {
     let grid = sized_grid("convert");
     for ext in ["msh", "vtu", "ply", "mesh"] {
         let out_path = tmp(&format!("conv.{ext}"));
-        let st = abgs().arg("convert").arg(&grid).arg(&out_path).status().unwrap();
+        let st = abgs()
+            .arg("convert")
+            .arg(&grid)
+            .arg(&out_path)
+            .status()
+            .unwrap();
         assert!(st.success());
         let g = abgs::Grid::load(&out_path).unwrap();
-        assert_eq!(g.sizes().unwrap(), abgs::Grid::load(&grid).unwrap().sizes().unwrap());
+        assert_eq!(
+            g.sizes().unwrap(),
+            abgs::Grid::load(&grid).unwrap().sizes().unwrap()
+        );
     }
 }
 
 #[test]
 fn bad_input_fails_with_a_message() {
-    let out = abgs().args(["info", "/nonexistent/x.stl"]).output().unwrap();
+    let out = abgs()
+        .args(["info", "/nonexistent/x.stl"])
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("abgs: error"));
     let pts = tmp("bad.txt");
     std::fs::write(&pts, "1 2\n").unwrap();
-    let out = abgs().arg("query").arg(sized_grid("bad")).arg("--points").arg(&pts).output().unwrap();
+    let out = abgs()
+        .arg("query")
+        .arg(sized_grid("bad"))
+        .arg("--points")
+        .arg(&pts)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("line 1"));
 }
 
 #[test]
 fn bench_query_runs_and_answers_agree() {
-    let out = abgs().arg("bench-query").arg(sized_grid("bench")).args(["--points", "2000", "--seconds", "0.01", "--json"]).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = abgs()
+        .arg("bench-query")
+        .arg(sized_grid("bench"))
+        .args(["--points", "2000", "--seconds", "0.01", "--json"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for set in v["results"].as_array().unwrap() {
         for run in set["runs"].as_array().unwrap() {
