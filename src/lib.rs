@@ -15,6 +15,24 @@
 //! - [`query`]: surface, hinted, batch and volume size queries.
 //! - [`sampling`]: deterministic point sets on and around a grid.
 //! - [`ffi`]: the C ABI.
+//!
+//! ```
+//! use abgs::{BuildOptions, Grid};
+//! // A unit square in z = 0 with sizes growing along x.
+//! let v = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+//! let t = vec![[0, 1, 2], [0, 2, 3]];
+//! let h = vec![0.1, 0.2, 0.2, 0.1];
+//! let grid = Grid::from_arrays(v, t, Some(h), &BuildOptions::default())?;
+//! // Surface mode: the closest point of (0.5, 0.5, 3) is (0.5, 0.5, 0).
+//! assert!((grid.query_size([0.5, 0.5, 3.0])? - 0.15).abs() < 1e-15);
+//! // Hinted: same answer, the hint now names the triangle used.
+//! let mut hint = u32::MAX;
+//! assert_eq!(grid.query_size_hinted([0.5, 0.5, 3.0], &mut hint)?, grid.query_size([0.5, 0.5, 3.0])?);
+//! // Volume mode with gradation 1.2: never above the surface size + ln(1.2)·distance.
+//! let vol = grid.query_volume([0.5, 0.5, 3.0], 1.2)?.size;
+//! assert!(vol <= 0.15 + 1.2f64.ln() * 3.0);
+//! # Ok::<(), abgs::Error>(())
+//! ```
 #![deny(missing_docs)]
 // Index loops over x, y, z read better than zipped iterators in geometry code.
 #![allow(clippy::needless_range_loop)]

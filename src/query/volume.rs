@@ -146,11 +146,24 @@ impl Grid {
         let sizes = self.sizes().expect("checked by caller");
         let tris = self.triangles();
         let bound = |i: usize| nmin[i] + s * bvh.nodes[i].bbox.distance2(&x).sqrt();
+        // Seed the bound with the triangle of the closest point: for graded fields
+        // the minimum is usually there or nearby.
         let mut best = VolumeHit {
             size: f64::INFINITY,
             triangle: u32::MAX,
             point: x,
         };
+        if let Some(hit) = bvh.closest(x, None) {
+            let slot = bvh.triangle_prim[hit.triangle as usize] as usize;
+            let c = bvh.prim_corners[slot];
+            let h = tris[hit.triangle as usize].map(|v| sizes[v as usize]);
+            let (val, b) = triangle_min(x, c, h, s);
+            best = VolumeHit {
+                size: val,
+                triangle: hit.triangle,
+                point: add(add(scale(c[0], b[0]), scale(c[1], b[1])), scale(c[2], b[2])),
+            };
+        }
         let mut stack = [(0u32, 0f64); MAX_DEPTH];
         let mut sp = 0;
         let mut node = 0usize;
