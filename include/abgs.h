@@ -27,6 +27,15 @@
 // Value of a hint that names no triangle.
 #define ABGS_NO_HINT UINT32_MAX
 
+// Source kind: a point (`points[0..3]`).
+#define ABGS_SOURCE_POINT 0
+
+// Source kind: a segment (`points[0..6]`).
+#define ABGS_SOURCE_SEGMENT 1
+
+// Source kind: a triangle (`points[0..9]`).
+#define ABGS_SOURCE_TRIANGLE 2
+
 // Result of every call. The numbers are stable across releases.
 typedef enum {
   // Success.
@@ -120,6 +129,88 @@ typedef struct {
   // Interpolated size (NaN when the grid has no sizes).
   double size;
 } abgs_hit;
+
+// A user size source: every vertex within `radius` of the shape gets at most `size`.
+typedef struct {
+  // `ABGS_SOURCE_POINT`, `ABGS_SOURCE_SEGMENT` or `ABGS_SOURCE_TRIANGLE`.
+  uint32_t kind;
+  // Up to three points, x y z each (unused entries ignored).
+  double points[9];
+  // Size imposed (finite, > 0).
+  double size;
+  // Radius of influence (finite, >= 0).
+  double radius;
+} abgs_size_source;
+
+// Parameters of `abgs_compute_size`; get the defaults from `abgs_size_params_default`.
+typedef struct {
+  // Elements per full circle for curvature sizes (default 24).
+  double n_circle;
+  // Elements across a gap or wall (default 3).
+  double n_gap;
+  // Smallest size; 0 = diagonal / 2000 (default 0).
+  double hmin;
+  // Largest size; 0 = diagonal / 10 (default 0).
+  double hmax;
+  // Dihedral angle above which an edge is a feature, degrees (default 30).
+  double feature_angle_deg;
+  // Size on feature-edge vertices; 0 = off (default 0).
+  double feature_size;
+  // Gradation ratio β > 1 (default 1.2), used when `slope` is 0.
+  double beta;
+  // Gradation slope |∇h| bound; > 0 overrides `beta` (default 0).
+  double slope;
+  // 1 = use curvature sizes (default 1).
+  int32_t curvature;
+  // 1 = use proximity sizes (default 1).
+  int32_t proximity;
+  // 1 = grade the result (default 1).
+  int32_t gradation;
+  // Gaps narrower than this are contacts, not gaps; 0 = hmin (default 0).
+  double contact_gap;
+  // `n_sources` user sources, or NULL.
+  const abgs_size_source *sources;
+  // Number of entries in `sources`.
+  size_t n_sources;
+} abgs_size_params;
+
+// What `abgs_compute_size` did.
+typedef struct {
+  // Smallest size used.
+  double hmin;
+  // Largest size used.
+  double hmax;
+  // Gradation slope used (0 when gradation was off).
+  double slope;
+  // Feature edges found.
+  uint64_t feature_edges;
+  // Smooth patches found.
+  uint64_t patches;
+  // Vertices whose H0 came from curvature.
+  uint64_t limited_by_curvature;
+  // Vertices whose H0 came from proximity.
+  uint64_t limited_by_proximity;
+  // Vertices whose H0 came from feature refinement.
+  uint64_t limited_by_feature;
+  // Vertices whose H0 came from a user source.
+  uint64_t limited_by_source;
+  // Vertices clamped up to hmin.
+  uint64_t clamped_to_hmin;
+  // Vertices at hmax.
+  uint64_t at_hmax;
+  // Faces the gradation's verify pass had to fix.
+  uint64_t faces_fixed;
+  // Largest face slope / slope after gradation (<= 1 + 1e-9).
+  double max_slope_ratio;
+  // Seconds for features and normals.
+  double seconds_features;
+  // Seconds for curvature.
+  double seconds_curvature;
+  // Seconds for proximity.
+  double seconds_proximity;
+  // Seconds for gradation.
+  double seconds_gradation;
+} abgs_size_report;
 
 #ifdef __cplusplus
 extern "C" {
@@ -314,6 +405,63 @@ abgs_status abgs_query_closest(const abgs_grid *grid,
                                const double *point,
                                uint32_t hint,
                                abgs_hit *out_hit);
+
+// Writes the default parameters into `*out_params`.
+//
+// # Safety
+// `out_params` is NULL (reported) or writable.
+abgs_status abgs_size_params_default(abgs_size_params *out_params);
+
+// Computes sizes on the grid's vertices from its geometry (curvature,
+// proximity, features, sources, clamped to [hmin, hmax], then graded) and
+// installs them; `out_report` (may be NULL) receives what was done.
+// Errors: NULL, INVALID_ARGUMENT / NON_FINITE / INVALID_SIZE (parameters), BUSY.
+//
+// # Safety
+// Pointers are NULL (reported) or valid; `params->sources` holds `n_sources` entries.
+abgs_status abgs_compute_size(abgs_grid *grid,
+                              const abgs_size_params *params,
+                              abgs_size_report *out_report);
+
+// Grades the grid's current sizes in place: the largest field below them with
+// |∇h| <= slope on every triangle, slope = `slope` if > 0 else ln(`beta`).
+// `out_faces_fixed` (may be NULL) receives the number of faces the verify pass
+// fixed. Errors: NULL, NO_SIZES, INVALID_ARGUMENT, BUSY. O(V log V).
+//
+// # Safety
+// Pointers are NULL (reported / ignored for the out-parameter) or valid.
+abgs_status abgs_apply_gradation(abgs_grid *grid,
+                                 double beta,
+                                 double slope,
+                                 uint64_t *out_faces_fixed);
+
+// Number of unique edges into `*out_count`.
+//
+// # Safety
+// Pointers are NULL (reported) or valid.
+abgs_status abgs_grid_edge_count(const abgs_grid *grid, size_t *out_count);
+
+// Copies the unique edges, two vertex indices each (smaller first), sorted
+// lexicographically, into `out_edges` (`capacity` >= 2 × edge count). This is
+// the order of the per-edge values of `abgs_lbo`.
+//
+// # Safety
+// Pointers are NULL (reported) or valid for `capacity` indices.
+abgs_status abgs_grid_copy_edges(const abgs_grid *grid, uint32_t *out_edges, size_t capacity);
+
+// Laplace–Beltrami operator of the sizes: per vertex into `out_vertex`
+// (`vertex_capacity` >= vertex count) and per edge into `out_edge`
+// (`edge_capacity` >= edge count, in `abgs_grid_copy_edges` order). Either
+// output may be NULL (with capacity 0) to skip it. Errors: NULL (grid, or both
+// outputs), NO_SIZES, BUFFER_TOO_SMALL. O(F).
+//
+// # Safety
+// Non-NULL outputs are writable for their capacity.
+abgs_status abgs_lbo(const abgs_grid *grid,
+                     double *out_vertex,
+                     size_t vertex_capacity,
+                     double *out_edge,
+                     size_t edge_capacity);
 
 #ifdef __cplusplus
 }  // extern "C"

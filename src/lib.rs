@@ -14,6 +14,7 @@
 //! - [`spatial`]: the bounding-volume hierarchy over triangles.
 //! - [`query`]: surface, hinted, batch and volume size queries.
 //! - [`sampling`]: deterministic point sets on and around a grid.
+//! - [`sizing`]: curvature, proximity, sources, gradation and LBO of the size field.
 //! - [`ffi`]: the C ABI.
 //!
 //! ```
@@ -44,6 +45,7 @@ pub mod io;
 pub mod mesh;
 pub mod query;
 pub mod sampling;
+pub mod sizing;
 pub mod spatial;
 
 pub use error::{Error, Result};

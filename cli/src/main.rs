@@ -9,6 +9,7 @@ mod info;
 mod points;
 mod progress;
 mod query;
+mod size;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -68,6 +69,28 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Compute sizes (curvature, proximity, features, sources, gradation) and write
+    /// them with the arrays size, h0, h_curv, h_prox and lbo.
+    Size {
+        /// Input grid.
+        grid: PathBuf,
+        /// Output file (vtk recommended).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        args: size::SizeArgs,
+    },
+    /// Check a sized grid: largest face slope against ln(beta), and h <= h0 where h0 is present.
+    CheckGradation {
+        /// Grid with sizes.
+        grid: PathBuf,
+        /// Gradation ratio.
+        #[arg(long, default_value_t = 1.2)]
+        beta: f64,
+        /// Slope (overrides --beta).
+        #[arg(long)]
+        slope: Option<f64>,
+    },
     /// Measure queries per second on three point sets (near-surface, uniform in the box,
     /// a coherent front-like walk) for plain, hinted and batch queries, 1 thread and all threads.
     BenchQuery {
@@ -103,6 +126,15 @@ fn main() -> ExitCode {
             seconds,
             json,
         } => bench::run(&grid, points, seconds, json),
+        Command::Size { grid, output, args } => size::run(&grid, &output, &args),
+        Command::CheckGradation { grid, beta, slope } => match size::check(&grid, beta, slope) {
+            Ok(true) => Ok(()),
+            Ok(false) => {
+                eprintln!("abgs: gradation bound violated");
+                return ExitCode::FAILURE;
+            }
+            Err(e) => Err(e),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

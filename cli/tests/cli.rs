@@ -161,3 +161,90 @@ fn bench_query_runs_and_answers_agree() {
         }
     }
 }
+
+#[test]
+fn size_writes_all_arrays_and_check_gradation_passes() {
+    // A bumpy plate so that curvature matters.
+    let n = 30;
+    let mut v = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            v.push([x, y, 0.05 * (8.0 * x).sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let input = tmp("bumpy.obj");
+    abgs::Grid::from_arrays(v, t, None, &abgs::BuildOptions::default())
+        .unwrap()
+        .save(&input)
+        .unwrap();
+    let out = tmp("bumpy-sized.vtk");
+    let st = abgs()
+        .arg("size")
+        .arg(&input)
+        .arg("-o")
+        .arg(&out)
+        .args(["--beta", "1.3", "--source", "point 0.5 0.5 0 0.003 0.05"])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let g = abgs::Grid::load(&out).unwrap();
+    let names: Vec<&str> = g.point_arrays().iter().map(|a| a.name.as_str()).collect();
+    for want in ["h0", "h_curv", "h_prox", "lbo"] {
+        assert!(names.contains(&want), "{want} missing from {names:?}");
+    }
+    let chk = abgs()
+        .arg("check-gradation")
+        .arg(&out)
+        .args(["--beta", "1.3"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&chk.stdout);
+    assert!(chk.status.success(), "{text}");
+    assert!(text.contains("faces above 1 + 1e-9:       0"), "{text}");
+    assert!(text.contains("h <= h0:                    yes"), "{text}");
+    // A steeper bound than the one used must be reported as violated.
+    let chk = abgs()
+        .arg("check-gradation")
+        .arg(&out)
+        .args(["--beta", "1.01"])
+        .output()
+        .unwrap();
+    assert!(!chk.status.success());
+    // H0 itself (no gradation) violates the bound near the source.
+    let raw = tmp("bumpy-raw.vtk");
+    assert!(abgs()
+        .arg("size")
+        .arg(&input)
+        .arg("-o")
+        .arg(&raw)
+        .args(["--no-gradation", "--source", "point 0.5 0.5 0 0.003 0.05"])
+        .status()
+        .unwrap()
+        .success());
+    let chk = abgs().arg("check-gradation").arg(&raw).output().unwrap();
+    assert!(!chk.status.success());
+    // Bad parameters fail cleanly.
+    let bad = abgs()
+        .arg("size")
+        .arg(&input)
+        .arg("-o")
+        .arg(&out)
+        .args(["--beta", "0.5"])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("beta"));
+}

@@ -16,7 +16,9 @@
 mod boundary;
 mod grid;
 mod query;
+mod sizing;
 
 pub use boundary::*;
 pub use grid::*;
 pub use query::*;
+pub use sizing::*;

@@ -1,11 +1,13 @@
 //! The background grid: an immutable triangle surface with one size per vertex,
 //! its adjacency, its BVH and the report of what was found on input.
 
+pub mod features;
 mod stats;
 mod topology;
 mod validate;
 pub mod weld;
 
+pub use features::Features;
 pub use stats::{AngleStats, GridStats};
 pub use topology::Topology;
 pub use validate::ValidationReport;

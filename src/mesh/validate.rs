@@ -213,15 +213,21 @@ pub fn orient(
         seen[seed] = true;
         queue.push_back(seed);
         while let Some(f) = queue.pop_front() {
-            let tf = oriented(&triangles[f], flip[f]);
+            let t = triangles[f];
             for k in 0..3 {
+                // Edge k joins corners k and k+1 of the stored triangle; f (as
+                // currently oriented) traverses it a→b.
                 let e = topo.face_edges[f][k] as usize;
                 let ef = topo.faces_of_edge(e);
                 if ef.len() != 2 {
                     continue;
                 }
                 let g = if ef[0] as usize == f { ef[1] } else { ef[0] } as usize;
-                let (a, b) = (tf[k], tf[(k + 1) % 3]);
+                let (a, b) = if flip[f] {
+                    (t[(k + 1) % 3], t[k])
+                } else {
+                    (t[k], t[(k + 1) % 3])
+                };
                 // Consistent neighbours traverse the shared edge the other way.
                 let g_needs_flip = has_directed(&triangles[g], a, b);
                 if !seen[g] {
@@ -323,6 +329,39 @@ mod tests {
         let topo = Topology::build(8, &t);
         assert_eq!(orient(&v, &mut t, &topo), (12, 0));
         assert!((signed_volume(&v, &t) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn orient_repairs_random_flips_on_a_strip() {
+        // A closed tube (8 around, 6 along) with caps removed: open, orientable.
+        let (n, m) = (8u32, 6u32);
+        let mut v = Vec::new();
+        for j in 0..=m {
+            for i in 0..n {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                v.push([a.cos(), a.sin(), j as f64]);
+            }
+        }
+        let id = |i: u32, j: u32| j * n + i % n;
+        let mut t = Vec::new();
+        for j in 0..m {
+            for i in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let good = t.clone();
+        for (k, tri) in t.iter_mut().enumerate() {
+            if (k * 7) % 3 == 0 {
+                tri.swap(1, 2);
+            }
+        }
+        let topo = Topology::build(v.len(), &t);
+        let (_, bad) = orient(&v, &mut t, &topo);
+        assert_eq!(bad, 0);
+        // Every triangle now agrees with the original orientation (or all disagree).
+        let same = t.iter().zip(&good).filter(|(a, b)| a == b).count();
+        assert!(same == t.len() || same == 0, "{same} of {}", t.len());
     }
 
     #[test]

@@ -1,5 +1,7 @@
 //! Spatial indexing: a bounding-volume hierarchy over triangles.
 
 mod bvh;
+mod ray;
 
 pub use bvh::{Bvh, ClosestHit, Node, MAX_DEPTH};
+pub use ray::ray_triangle;

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod shapes;
+
 use std::path::PathBuf;
 
 /// The third-party models folder (`../shared/meshes` beside the checkout).

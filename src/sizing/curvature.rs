@@ -1,0 +1,244 @@
+//! Principal curvatures and directions per vertex, estimated per smooth patch.
+//!
+//! For each (vertex, patch) pair, every neighbour `q` of vertex `p` in that patch
+//! gives a normal curvature along its tangent direction,
+//! `κ = −2 n·(q − p) / |q − p|²` (exact for points on a sphere through p with
+//! normal n); a least-squares fit of the second fundamental form
+//! `κ(θ) = a cos²θ + 2b cosθ sinθ + c sin²θ` to these gives the shape operator,
+//! whose eigen-pairs are the principal curvatures and directions. Neighbours are
+//! the 1-ring in the patch, widened to the 2-ring when fewer than four. Nothing
+//! is taken across a feature edge or from another body. Sign: positive where the
+//! surface bends away from its normal (convex for outward normals).
+
+use super::normals::PatchNormals;
+use crate::geometry::*;
+use crate::mesh::{Features, Grid};
+use rayon::prelude::*;
+
+/// Principal curvatures at a vertex (from the patch where they are largest).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Curvature {
+    /// Curvature of largest magnitude.
+    pub k1: f64,
+    /// The other principal curvature (|k2| ≤ |k1|).
+    pub k2: f64,
+    /// Unit direction of `k1` (tangent).
+    pub d1: [f64; 3],
+    /// Unit direction of `k2` (tangent).
+    pub d2: [f64; 3],
+}
+
+impl Curvature {
+    /// `max(|k1|, |k2|)`.
+    pub fn max_abs(&self) -> f64 {
+        self.k1.abs().max(self.k2.abs())
+    }
+}
+
+/// A unit vector orthogonal to unit `n`.
+fn perpendicular(n: [f64; 3]) -> [f64; 3] {
+    let a = if n[0].abs() < 0.6 {
+        [1.0, 0.0, 0.0]
+    } else if n[1].abs() < 0.6 {
+        [0.0, 1.0, 0.0]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    let c = cross(n, a);
+    scale(c, 1.0 / norm(c))
+}
+
+/// Fits the shape operator at `p` with normal `n` to the neighbours `qs`.
+fn fit(p: [f64; 3], n: [f64; 3], qs: &[[f64; 3]]) -> Curvature {
+    if qs.is_empty() || norm2(n) == 0.0 {
+        return Curvature::default();
+    }
+    let e1 = perpendicular(n);
+    let e2 = cross(n, e1);
+    let mut ata = [[0.0f64; 3]; 3];
+    let mut atb = [0.0f64; 3];
+    let mut kmax: f64 = 0.0;
+    let mut kmin: f64 = f64::INFINITY;
+    let mut kmax_dir = e1;
+    for &q in qs {
+        let d = sub(q, p);
+        let l2 = norm2(d);
+        if l2 == 0.0 {
+            continue;
+        }
+        let kappa = -2.0 * dot(n, d) / l2;
+        let (x, y) = (dot(d, e1), dot(d, e2));
+        let r = (x * x + y * y).sqrt();
+        if r == 0.0 {
+            continue;
+        }
+        let (c, s) = (x / r, y / r);
+        let row = [c * c, 2.0 * c * s, s * s];
+        for i in 0..3 {
+            for j in 0..3 {
+                ata[i][j] += row[i] * row[j];
+            }
+            atb[i] += row[i] * kappa;
+        }
+        if kappa.abs() > kmax.abs() {
+            kmax = kappa;
+            kmax_dir = add(scale(e1, c), scale(e2, s));
+        }
+        kmin = kmin.min(kappa.abs());
+    }
+    let det = det3(&ata);
+    let tr = ata[0][0] + ata[1][1] + ata[2][2];
+    let well_posed = det > 1e-6 * tr * tr * tr;
+    if !well_posed {
+        // Too few directions for a tensor: keep the largest normal curvature seen.
+        let k2 = if kmin.is_finite() {
+            kmin.copysign(kmax)
+        } else {
+            0.0
+        };
+        return Curvature {
+            k1: kmax,
+            k2,
+            d1: kmax_dir,
+            d2: cross(n, kmax_dir),
+        };
+    }
+    let [a, b, c] = solve3(&ata, &atb, det);
+    // Eigen-decomposition of [[a, b], [b, c]].
+    let m = 0.5 * (a + c);
+    let r = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+    let (l1, l2) = (m + r, m - r);
+    let (k1, k2) = if l1.abs() >= l2.abs() {
+        (l1, l2)
+    } else {
+        (l2, l1)
+    };
+    let (ux, uy) = if (k1 - a).abs() + b.abs() > (k1 - c).abs() + b.abs() {
+        (b, k1 - a)
+    } else {
+        (k1 - c, b)
+    };
+    let ul = (ux * ux + uy * uy).sqrt();
+    let d1 = if ul > 0.0 {
+        add(scale(e1, ux / ul), scale(e2, uy / ul))
+    } else {
+        e1
+    };
+    Curvature {
+        k1,
+        k2,
+        d1,
+        d2: cross(n, d1),
+    }
+}
+
+fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+}
+
+/// Cramer's rule.
+fn solve3(m: &[[f64; 3]; 3], b: &[f64; 3], det: f64) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for k in 0..3 {
+        let mut mk = *m;
+        for i in 0..3 {
+            mk[i][k] = b[i];
+        }
+        out[k] = det3(&mk) / det;
+    }
+    out
+}
+
+/// Principal curvatures of every vertex. O(V · ring size), parallel.
+pub fn principal_curvatures(
+    grid: &Grid,
+    features: &Features,
+    normals: &PatchNormals,
+) -> Vec<Curvature> {
+    let v = grid.vertices();
+    let tris = grid.triangles();
+    let topo = grid.topology();
+    (0..v.len())
+        .into_par_iter()
+        .map(|vi| {
+            let mut best = Curvature::default();
+            let mut ring: Vec<u32> = Vec::new();
+            let mut pts: Vec<[f64; 3]> = Vec::new();
+            for e in normals.range(vi) {
+                let patch = normals.patch[e];
+                ring.clear();
+                let collect = |u: usize, ring: &mut Vec<u32>| {
+                    for &f in topo.faces_of_vertex(u) {
+                        if features.face_patch[f as usize] == patch {
+                            for &w in &tris[f as usize] {
+                                if w as usize != vi && !ring.contains(&w) {
+                                    ring.push(w);
+                                }
+                            }
+                        }
+                    }
+                };
+                collect(vi, &mut ring);
+                if ring.len() < 4 {
+                    let first: Vec<u32> = ring.clone();
+                    for u in first {
+                        collect(u as usize, &mut ring);
+                    }
+                }
+                pts.clear();
+                pts.extend(ring.iter().map(|&w| v[w as usize]));
+                let c = fit(v[vi], normals.normal[e], &pts);
+                if c.max_abs() > best.max_abs() || best.d1 == [0.0; 3] {
+                    best = c;
+                }
+            }
+            best
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fit_on_exact_sphere_and_cylinder_points() {
+        // Sphere of radius 2 through p = (0,0,2), outward normal +z.
+        let r: f64 = 2.0;
+        let p = [0.0, 0.0, r];
+        let qs: Vec<[f64; 3]> = (0..7)
+            .map(|i| {
+                let ph = i as f64 * 0.9;
+                let th: f64 = 0.3 + 0.05 * i as f64;
+                [
+                    r * th.sin() * ph.cos(),
+                    r * th.sin() * ph.sin(),
+                    r * th.cos(),
+                ]
+            })
+            .collect();
+        let c = fit(p, [0.0, 0.0, 1.0], &qs);
+        assert!(
+            (c.k1 - 0.5).abs() < 1e-12 && (c.k2 - 0.5).abs() < 1e-12,
+            "{c:?}"
+        );
+        // Cylinder of radius 1 along y through p = (0,0,1): k1 = 1 along x, k2 = 0 along y.
+        let qs: Vec<[f64; 3]> = [
+            (0.2, 0.0),
+            (-0.2, 0.0),
+            (0.0, 0.3),
+            (0.0, -0.3),
+            (0.15, 0.15),
+            (-0.1, 0.2),
+        ]
+        .iter()
+        .map(|&(a, y): &(f64, f64)| [a.sin(), y, a.cos()])
+        .collect();
+        let c = fit([0.0, 0.0, 1.0], [0.0, 0.0, 1.0], &qs);
+        assert!((c.k1 - 1.0).abs() < 0.02, "{c:?}");
+        assert!(c.k2.abs() < 0.02);
+        assert!(c.d1[0].abs() > 0.99);
+    }
+}

@@ -1,0 +1,63 @@
+//! Proximity (thin walls, slots, gaps between bodies) by ray casting.
+//!
+//! From every vertex, for each of its patch normals n (and, on feature lines,
+//! their bisector), rays along −n (through
+//! the material: wall thickness) and +n (across empty space: gaps to other
+//! sheets and to other bodies) find the nearest triangle that *faces back*
+//! (`n · n_hit < −0.2`, i.e. an opposite wall, not a perpendicular one seen
+//! edge-on). Ignored: the vertex's own faces, hits closer than the contact gap
+//! (touching bodies, and the tessellation noise between coincident curved faces:
+//! a conformal interface, not a gap), and hits beyond `max_gap`. The gap is the smallest such distance.
+
+use super::normals::PatchNormals;
+use crate::geometry::*;
+use crate::mesh::Grid;
+use rayon::prelude::*;
+
+/// Cosine below which a hit face counts as facing back.
+const FACING_BACK: f64 = -0.2;
+
+/// Smallest gap per vertex (`+inf` where no opposite wall lies within `max_gap`).
+/// O(V log F), parallel over vertices.
+pub fn gaps(grid: &Grid, normals: &PatchNormals, contact_gap: f64, max_gap: f64) -> Vec<f64> {
+    let v = grid.vertices();
+    let topo = grid.topology();
+    let bvh = grid.bvh();
+    (0..v.len())
+        .into_par_iter()
+        .map(|vi| {
+            let own = topo.faces_of_vertex(vi);
+            let mut best = f64::INFINITY;
+            let range = normals.range(vi);
+            // On a feature line or corner, rays along one patch normal graze the
+            // other patches; the bisector of the patch normals sees the wall
+            // diagonally instead.
+            let bisector = if range.len() > 1 {
+                let s = range
+                    .clone()
+                    .fold([0.0; 3], |a, e| add(a, normals.normal[e]));
+                let l = norm(s);
+                (l > 1e-9).then(|| scale(s, 1.0 / l))
+            } else {
+                None
+            };
+            let dirs = range.map(|e| normals.normal[e]).chain(bisector);
+            for n in dirs {
+                if norm2(n) == 0.0 {
+                    continue;
+                }
+                for dir in [scale(n, -1.0), n] {
+                    let limit = best.min(max_gap);
+                    let hit = bvh.first_hit(v[vi], dir, contact_gap, limit, |tri, _| {
+                        own.binary_search(&tri).is_err()
+                            && dot(n, normals.face_normal[tri as usize]) < FACING_BACK
+                    });
+                    if let Some((_, t)) = hit {
+                        best = best.min(t);
+                    }
+                }
+            }
+            best
+        })
+        .collect()
+}
