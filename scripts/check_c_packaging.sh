@@ -158,10 +158,10 @@ run cmake -S "$repo/examples_c" -B "$tmp/build-src" -Dabgs_DIR="$repo/cmake" \
 run cmake --build "$tmp/build-src"
 run_example "$tmp/build-src/query_basic"
 run_example "$tmp/build-src/query_basic_static"
-if ldd "$tmp/build-src/query_basic_static" | grep -q libabgs; then
+if grep -q libabgs <<<"$(ldd "$tmp/build-src/query_basic_static")"; then
   fail "query_basic_static depends on libabgs.so"
 fi
-readelf -d "$tmp/build-src/query_basic" | grep -q 'NEEDED.*\[libabgs.so\]' \
+grep -q 'NEEDED.*\[libabgs.so\]' <<<"$(readelf -d "$tmp/build-src/query_basic")" \
   || fail "query_basic does not record libabgs.so as a plain NEEDED entry"
 
 # find_package version rules and the not-built message, on throw-away projects.
@@ -218,8 +218,10 @@ grep -q "abgs_DIR:PATH=$prefix/lib/cmake/abgs" "$tmp/build-inst/CMakeCache.txt" 
 run cmake --build "$tmp/build-inst"
 run_example "$tmp/build-inst/query_basic"
 run_example "$tmp/build-inst/query_basic_static"
-ldd "$tmp/build-inst/query_basic" | grep -q "$prefix/lib/libabgs.so" \
-  || { ldd "$tmp/build-inst/query_basic"; fail "the CMake build does not load $prefix/lib/libabgs.so"; }
+# (ldd into a variable first: `ldd | grep -q` can fail under pipefail when grep exits early.)
+deps=$(ldd "$tmp/build-inst/query_basic")
+grep -q "$prefix/lib/libabgs.so" <<<"$deps" \
+  || { echo "$deps"; fail "the CMake build does not load $prefix/lib/libabgs.so"; }
 # The installed version file must not depend on the source tree.
 probe inst "$major.$minor" -DCMAKE_PREFIX_PATH="$prefix" \
   || { cat "$tmp/probe-inst.log"; fail "installed find_package(abgs $major.$minor) failed"; }
@@ -240,14 +242,15 @@ echo "pkg-config --static --libs abgs: $(pkg-config --static --libs abgs)"
 run "$cc_bin" -std=c11 -O2 -Wall -Wextra -Werror -pedantic "$repo/examples_c/query_basic.c" \
   $pc_flags -o "$tmp/query_basic_pc"
 LD_LIBRARY_PATH="$prefix/lib" run_example "$tmp/query_basic_pc"
-LD_LIBRARY_PATH="$prefix/lib" ldd "$tmp/query_basic_pc" | grep -q "$prefix/lib/libabgs.so" \
+deps=$(LD_LIBRARY_PATH="$prefix/lib" ldd "$tmp/query_basic_pc")
+grep -q "$prefix/lib/libabgs.so" <<<"$deps" \
   || fail "the pkg-config build does not load $prefix/lib/libabgs.so"
 # libabgs.a with the private libraries (-l:libabgs.a picks the archive).
 pc_static=$(pkg-config --static --libs abgs | sed 's/-labgs/-l:libabgs.a/')
 # shellcheck disable=SC2086
 run "$cc_bin" -std=c11 -O2 -Wall -Wextra -Werror -pedantic $(pkg-config --cflags abgs) \
   "$repo/examples_c/query_basic.c" $pc_static -o "$tmp/query_basic_pc_static"
-if ldd "$tmp/query_basic_pc_static" | grep -q libabgs; then
+if grep -q libabgs <<<"$(ldd "$tmp/query_basic_pc_static")"; then
   fail "query_basic_pc_static depends on libabgs.so"
 fi
 run_example "$tmp/query_basic_pc_static"
