@@ -112,37 +112,9 @@ pub fn detect(
             _ => NON_MANIFOLD,
         };
     }
-    // Patches: union-find over faces across smooth edges.
-    let nf = triangles.len();
-    let mut parent: Vec<u32> = (0..nf as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            let g = p[p[x as usize] as usize];
-            p[x as usize] = g;
-            x = g;
-        }
-        x
-    }
-    for (e, &flag) in edge_flags.iter().enumerate() {
-        if flag == 0 {
-            let fs = topo.faces_of_edge(e);
-            let (a, b) = (find(&mut parent, fs[0]), find(&mut parent, fs[1]));
-            if a != b {
-                parent[a.max(b) as usize] = a.min(b);
-            }
-        }
-    }
-    let mut label = vec![u32::MAX; nf];
-    let mut face_patch = vec![0u32; nf];
-    let mut patch_count = 0;
-    for (f, fp) in face_patch.iter_mut().enumerate() {
-        let r = find(&mut parent, f as u32) as usize;
-        if label[r] == u32::MAX {
-            label[r] = patch_count;
-            patch_count += 1;
-        }
-        *fp = label[r];
-    }
+    // Patches: components of faces across smooth edges.
+    let (face_patch, patch_count) =
+        topo.label_face_components(triangles.len(), |e| edge_flags[e] == 0);
     let mut vertex_feature_valence = vec![0u32; vertices.len()];
     for (e, &flag) in edge_flags.iter().enumerate() {
         if flag != 0 {
@@ -165,25 +137,8 @@ mod tests {
     use super::*;
     use crate::mesh::BuildOptions;
 
-    /// Unit cube, two triangles per face.
-    pub(crate) fn cube() -> Grid {
-        let v = (0..8)
-            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
-            .collect();
-        let t = vec![
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ];
+    fn cube() -> Grid {
+        let (v, t) = crate::mesh::validate::tests::cube();
         Grid::from_arrays(v, t, None, &BuildOptions::default()).unwrap()
     }
 

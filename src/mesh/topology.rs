@@ -99,27 +99,29 @@ impl Topology {
 
     /// Union-find over faces joined by manifold edges (exactly two faces).
     fn label_bodies(&mut self, face_count: usize) {
+        let (labels, count) = self.label_face_components(face_count, |_| true);
+        self.face_body = labels;
+        self.body_count = count;
+    }
+
+    /// Connected components of the faces, joining the two faces of every
+    /// manifold edge `e` for which `joins(e)` is true. Components are numbered
+    /// 0.. in order of their lowest face index; returns (label per face, count).
+    /// O(F α(F)).
+    pub fn label_face_components(
+        &self,
+        face_count: usize,
+        joins: impl Fn(usize) -> bool,
+    ) -> (Vec<u32>, u32) {
         let mut parent: Vec<u32> = (0..face_count as u32).collect();
-        fn find(p: &mut [u32], mut x: u32) -> u32 {
-            while p[x as usize] != x {
-                let g = p[p[x as usize] as usize];
-                p[x as usize] = g;
-                x = g;
-            }
-            x
-        }
         for e in 0..self.edges.len() {
             let fs = self.faces_of_edge(e);
-            if fs.len() == 2 {
-                let (ra, rb) = (find(&mut parent, fs[0]), find(&mut parent, fs[1]));
-                if ra != rb {
-                    let (lo, hi) = (ra.min(rb), ra.max(rb));
-                    parent[hi as usize] = lo;
-                }
+            if fs.len() == 2 && joins(e) {
+                union(&mut parent, fs[0], fs[1]);
             }
         }
         let mut label = vec![u32::MAX; face_count];
-        let mut face_body = vec![0u32; face_count];
+        let mut out = vec![0u32; face_count];
         let mut count = 0;
         for f in 0..face_count {
             let r = find(&mut parent, f as u32) as usize;
@@ -127,10 +129,9 @@ impl Topology {
                 label[r] = count;
                 count += 1;
             }
-            face_body[f] = label[r];
+            out[f] = label[r];
         }
-        self.face_body = face_body;
-        self.body_count = count;
+        (out, count)
     }
 
     /// Faces incident to edge `e`. O(1).
@@ -165,6 +166,24 @@ impl Topology {
     pub fn find_edge(&self, a: u32, b: u32) -> Option<usize> {
         let key = [a.min(b), a.max(b)];
         self.edges.binary_search(&key).ok()
+    }
+}
+
+/// Union-find root of `x` with path halving.
+pub(crate) fn find(parent: &mut [u32], mut x: u32) -> u32 {
+    while parent[x as usize] != x {
+        let g = parent[parent[x as usize] as usize];
+        parent[x as usize] = g;
+        x = g;
+    }
+    x
+}
+
+/// Joins the sets of `a` and `b`; the lower root becomes the root.
+pub(crate) fn union(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    if ra != rb {
+        parent[ra.max(rb) as usize] = ra.min(rb);
     }
 }
 

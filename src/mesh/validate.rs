@@ -3,7 +3,7 @@
 //! orientation made consistent per body (outward for closed bodies), and the
 //! [`ValidationReport`] that names every defect found.
 
-use super::topology::Topology;
+use super::topology::{find, union, Topology};
 use crate::error::{Error, Result};
 use crate::geometry::{cross, dot, norm, sub};
 
@@ -154,12 +154,6 @@ pub fn count_non_manifold_vertices(topo: &Topology, vertex_count: usize) -> usiz
         // Union-find over the star's faces through manifold edges containing v.
         local.clear();
         local.extend(0..faces.len() as u32);
-        fn find(p: &mut [u32], mut x: u32) -> u32 {
-            while p[x as usize] != x {
-                x = p[x as usize];
-            }
-            x
-        }
         for (i, &f) in faces.iter().enumerate() {
             for &e in &topo.face_edges[f as usize] {
                 let ed = topo.edges[e as usize];
@@ -172,8 +166,7 @@ pub fn count_non_manifold_vertices(topo: &Topology, vertex_count: usize) -> usiz
                 }
                 let g = if ef[0] == f { ef[1] } else { ef[0] };
                 if let Ok(j) = faces.binary_search(&g) {
-                    let (a, b) = (find(&mut local, i as u32), find(&mut local, j as u32));
-                    local[a.max(b) as usize] = a.min(b);
+                    union(&mut local, i as u32, j as u32);
                 }
             }
         }
@@ -282,10 +275,11 @@ fn oriented(t: &[u32; 3], flip: bool) -> [u32; 3] {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn cube() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    /// Unit cube, two outward triangles per face.
+    pub(crate) fn cube() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
         let v = (0..8)
             .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
             .collect();
