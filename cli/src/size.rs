@@ -40,6 +40,9 @@ pub struct SizeArgs {
     /// Ignore proximity.
     #[arg(long)]
     pub no_proximity: bool,
+    /// Gaps narrower than this are contacts between touching parts, not gaps (default: hmin).
+    #[arg(long)]
+    pub contact_gap: Option<f64>,
     /// A user source: "point X Y Z SIZE RADIUS", "segment X1 Y1 Z1 X2 Y2 Z2 SIZE RADIUS"
     /// or "triangle X1 .. Z3 SIZE RADIUS" (repeatable).
     #[arg(long = "source")]
