@@ -329,7 +329,8 @@ abgs_status abgs_grid_copy_triangles(const abgs_grid *grid,
 abgs_status abgs_grid_copy_sizes(const abgs_grid *grid, double *out_sizes, size_t capacity);
 
 // Releases a grid. NULL is accepted and ignored. Returns BUSY (and frees
-// nothing) if another call is still using the grid.
+// nothing) if another call is still using the grid; as with `free`, no thread
+// may start a call on the grid once this one has begun.
 //
 // # Safety
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
@@ -361,7 +362,8 @@ abgs_status abgs_query_size_hinted(const abgs_grid *grid,
 // Sizes at `n` points (`points`: 3n doubles) into `out_sizes` (n doubles),
 // in parallel on the rayon thread pool (`RAYON_NUM_THREADS` sets its size).
 // Results equal the single queries', whatever the thread count. All points are
-// checked first: on error nothing is written.
+// checked first: on error nothing is written. `points` and `out_sizes` must not
+// overlap.
 //
 // # Safety
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
@@ -383,7 +385,8 @@ abgs_status abgs_query_size_volume(const abgs_grid *grid,
                                    double beta,
                                    double *out_size);
 
-// Batch of volume-mode queries, in parallel (see `abgs_query_sizes`).
+// Batch of volume-mode queries, in parallel (see `abgs_query_sizes`; the buffers
+// must not overlap).
 //
 // # Safety
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated

@@ -392,7 +392,8 @@ pub unsafe extern "C" fn abgs_grid_copy_sizes(
 }
 
 /// Releases a grid. NULL is accepted and ignored. Returns BUSY (and frees
-/// nothing) if another call is still using the grid.
+/// nothing) if another call is still using the grid; as with `free`, no thread
+/// may start a call on the grid once this one has begun.
 ///
 /// # Safety
 /// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated

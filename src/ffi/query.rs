@@ -76,7 +76,8 @@ pub unsafe extern "C" fn abgs_query_size_hinted(
 /// Sizes at `n` points (`points`: 3n doubles) into `out_sizes` (n doubles),
 /// in parallel on the rayon thread pool (`RAYON_NUM_THREADS` sets its size).
 /// Results equal the single queries', whatever the thread count. All points are
-/// checked first: on error nothing is written.
+/// checked first: on error nothing is written. `points` and `out_sizes` must not
+/// overlap.
 ///
 /// # Safety
 /// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
@@ -127,7 +128,8 @@ pub unsafe extern "C" fn abgs_query_size_volume(
     })
 }
 
-/// Batch of volume-mode queries, in parallel (see `abgs_query_sizes`).
+/// Batch of volume-mode queries, in parallel (see `abgs_query_sizes`; the buffers
+/// must not overlap).
 ///
 /// # Safety
 /// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
