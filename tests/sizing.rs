@@ -200,3 +200,23 @@ fn pipeline_grades_and_respects_bounds() {
         assert!(sizing::compute(&g, &bad).is_err());
     }
 }
+
+#[test]
+fn same_bits_with_one_and_two_threads() {
+    let Some(dir) = common::shared_meshes() else {
+        return;
+    };
+    let g = abgs::Grid::load(&dir.join("occt_crankarm.stl")).unwrap();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| sizing::compute(&g, &SizeParams::default()).unwrap())
+    };
+    let (a, b) = (run(1), run(2));
+    assert_eq!(a.h, b.h);
+    assert_eq!(a.h0, b.h0);
+    assert_eq!(a.h_prox, b.h_prox);
+    assert_eq!(a.h_curv, b.h_curv);
+}
