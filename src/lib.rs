@@ -44,6 +44,7 @@ pub mod geometry;
 pub mod io;
 pub mod mesh;
 pub mod query;
+pub mod remesh;
 pub mod sampling;
 pub mod sizing;
 pub mod spatial;

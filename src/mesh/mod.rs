@@ -2,6 +2,7 @@
 //! its adjacency, its BVH and the report of what was found on input.
 
 pub mod features;
+pub mod halfedge;
 mod stats;
 mod topology;
 mod validate;

@@ -1,0 +1,533 @@
+//! A mutable half-edge triangle mesh for local operations (isotropic remeshing,
+//! edge-collapse simplification).
+//!
+//! # Layout
+//! - Elements are `u32` indices. Edge `e` owns the two half-edges `2e` and
+//!   `2e + 1`, so `opposite(h) = h ^ 1` and `edge(h) = h / 2`.
+//! - Each half-edge stores its target vertex, next, previous and face ([`NONE`]
+//!   on a boundary). Each vertex stores one outgoing half-edge, a *boundary*
+//!   one when the vertex is on a boundary (so [`HalfedgeMesh::is_boundary_vertex`]
+//!   is O(1)); each face one of its half-edges.
+//! - Removed elements are tombstones (flags) until [`HalfedgeMesh::compact`];
+//!   [`HalfedgeMesh::vertices`], [`HalfedgeMesh::edges`] and
+//!   [`HalfedgeMesh::faces`] skip them.
+//! - Every vertex is manifold (its faces form one fan, closed or open). Inputs
+//!   that are not (bodies touching along edges or at points) are made so by
+//!   [`HalfedgeMesh::from_grid`], which duplicates those vertices (flag
+//!   [`V_LOCKED`], `vertex_origin` naming the input vertex); [`HalfedgeMesh::to_arrays`]
+//!   merges the copies back.
+//!
+//! # Payload (public, one entry per element slot, kept in step by every operation)
+//! positions (f64), a per-vertex size, vertex flags, the input vertex each
+//! vertex copies, a per-vertex hint (e.g. the closest reference triangle),
+//! edge flags, a per-edge feature-line id and a per-face patch id.
+//!
+//! # Operations
+//! [`HalfedgeMesh::split`], [`HalfedgeMesh::collapse`] (checked by
+//! [`HalfedgeMesh::can_collapse`], the link condition) and [`HalfedgeMesh::flip`]
+//! (checked by [`HalfedgeMesh::is_flip_ok`]) are O(valence); the mesh never
+//! checks geometry or flags: callers decide what may be changed.
+
+mod build;
+mod ops;
+
+pub use build::BuildReport;
+
+use crate::geometry::{cross, norm, sub};
+
+/// The invalid index (no face on a boundary half-edge, no element).
+pub const NONE: u32 = u32::MAX;
+
+/// Vertex flag: the vertex lies on a feature line.
+pub const V_FEATURE: u8 = 1;
+/// Vertex flag: a corner; never moved, never removed.
+pub const V_CORNER: u8 = 2;
+/// Vertex flag: a copy of a non-manifold input vertex (or of a vertex of a face
+/// that could not be linked); never moved, merged with its twins on output.
+pub const V_LOCKED: u8 = 4;
+
+/// Edge flag: a feature edge (boundary, sharp, or non-manifold in the input).
+pub const E_FEATURE: u8 = 1;
+/// Edge flag: locked (non-manifold in the input, or unlinkable); never split,
+/// collapsed or flipped.
+pub const E_LOCKED: u8 = 2;
+
+/// A mutable half-edge triangle mesh with tombstones. See the module docs.
+#[derive(Debug, Clone, Default)]
+pub struct HalfedgeMesh {
+    to: Vec<u32>,
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    hface: Vec<u32>,
+    vout: Vec<u32>,
+    fhe: Vec<u32>,
+    vdel: Vec<bool>,
+    edel: Vec<bool>,
+    fdel: Vec<bool>,
+    deleted: [usize; 3],
+    /// Vertex positions.
+    pub positions: Vec<[f64; 3]>,
+    /// Per-vertex size payload (target edge length, or a size field value).
+    pub vertex_size: Vec<f64>,
+    /// Per-vertex flags ([`V_FEATURE`], [`V_CORNER`], [`V_LOCKED`]).
+    pub vertex_flags: Vec<u8>,
+    /// Input vertex a vertex was built from ([`NONE`] for vertices made later).
+    pub vertex_origin: Vec<u32>,
+    /// Per-vertex hint, e.g. the index of the closest reference triangle or
+    /// segment ([`NONE`] = none). Split copies the hint of the edge's first end.
+    pub vertex_hint: Vec<u32>,
+    /// Per-edge flags ([`E_FEATURE`], [`E_LOCKED`]).
+    pub edge_flags: Vec<u8>,
+    /// Per-edge feature-line id ([`NONE`] off features).
+    pub edge_line: Vec<u32>,
+    /// Per-face patch id (smooth region of the input the face lies on).
+    pub face_patch: Vec<u32>,
+}
+
+/// Outgoing half-edges of a vertex (see [`HalfedgeMesh::outgoing`]).
+#[derive(Debug, Clone)]
+pub struct Outgoing<'a> {
+    mesh: &'a HalfedgeMesh,
+    start: u32,
+    cur: u32,
+}
+
+impl Iterator for Outgoing<'_> {
+    type Item = u32;
+    fn next(&mut self) -> Option<u32> {
+        if self.cur == NONE {
+            return None;
+        }
+        let h = self.cur;
+        let n = self.mesh.next[(h ^ 1) as usize];
+        self.cur = if n == self.start { NONE } else { n };
+        Some(h)
+    }
+}
+
+impl HalfedgeMesh {
+    /// An empty mesh.
+    pub fn new() -> HalfedgeMesh {
+        HalfedgeMesh::default()
+    }
+
+    /// Adds an isolated vertex at `p` (size 0, no flags, no origin, no hint).
+    pub fn add_vertex(&mut self, p: [f64; 3]) -> u32 {
+        let v = self.positions.len() as u32;
+        self.positions.push(p);
+        self.vout.push(NONE);
+        self.vdel.push(false);
+        self.vertex_size.push(0.0);
+        self.vertex_flags.push(0);
+        self.vertex_origin.push(NONE);
+        self.vertex_hint.push(NONE);
+        v
+    }
+
+    /// New edge from `a` to `b` with unlinked half-edges; returns the half-edge `a → b`.
+    fn new_edge(&mut self, a: u32, b: u32) -> u32 {
+        let h = self.to.len() as u32;
+        self.to.extend([b, a]);
+        self.next.extend([NONE, NONE]);
+        self.prev.extend([NONE, NONE]);
+        self.hface.extend([NONE, NONE]);
+        self.edel.push(false);
+        self.edge_flags.push(0);
+        self.edge_line.push(NONE);
+        h
+    }
+
+    fn new_face(&mut self, patch: u32) -> u32 {
+        let f = self.fhe.len() as u32;
+        self.fhe.push(NONE);
+        self.fdel.push(false);
+        self.face_patch.push(patch);
+        f
+    }
+
+    #[inline]
+    fn link(&mut self, a: u32, b: u32) {
+        self.next[a as usize] = b;
+        self.prev[b as usize] = a;
+    }
+
+    /// Vertex slots, deleted ones included.
+    pub fn n_vertices(&self) -> usize {
+        self.positions.len()
+    }
+    /// Edge slots, deleted ones included.
+    pub fn n_edges(&self) -> usize {
+        self.edel.len()
+    }
+    /// Face slots, deleted ones included.
+    pub fn n_faces(&self) -> usize {
+        self.fhe.len()
+    }
+    /// Live vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.n_vertices() - self.deleted[0]
+    }
+    /// Live edges.
+    pub fn edge_count(&self) -> usize {
+        self.n_edges() - self.deleted[1]
+    }
+    /// Live faces.
+    pub fn face_count(&self) -> usize {
+        self.n_faces() - self.deleted[2]
+    }
+    /// True when vertex slot `v` was removed.
+    #[inline]
+    pub fn vertex_deleted(&self, v: u32) -> bool {
+        self.vdel[v as usize]
+    }
+    /// True when edge slot `e` was removed.
+    #[inline]
+    pub fn edge_deleted(&self, e: u32) -> bool {
+        self.edel[e as usize]
+    }
+    /// True when face slot `f` was removed.
+    #[inline]
+    pub fn face_deleted(&self, f: u32) -> bool {
+        self.fdel[f as usize]
+    }
+    /// Live vertices, ascending.
+    pub fn vertices(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.n_vertices() as u32).filter(|&v| !self.vdel[v as usize])
+    }
+    /// Live edges, ascending.
+    pub fn edges(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.n_edges() as u32).filter(|&e| !self.edel[e as usize])
+    }
+    /// Live faces, ascending.
+    pub fn faces(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.n_faces() as u32).filter(|&f| !self.fdel[f as usize])
+    }
+
+    /// Vertex a half-edge points to.
+    #[inline]
+    pub fn to_vertex(&self, h: u32) -> u32 {
+        self.to[h as usize]
+    }
+    /// Vertex a half-edge starts from.
+    #[inline]
+    pub fn from_vertex(&self, h: u32) -> u32 {
+        self.to[(h ^ 1) as usize]
+    }
+    /// Next half-edge in the face (or boundary loop).
+    #[inline]
+    pub fn next(&self, h: u32) -> u32 {
+        self.next[h as usize]
+    }
+    /// Previous half-edge in the face (or boundary loop).
+    #[inline]
+    pub fn prev(&self, h: u32) -> u32 {
+        self.prev[h as usize]
+    }
+    /// The opposite half-edge.
+    #[inline]
+    pub fn opposite(&self, h: u32) -> u32 {
+        h ^ 1
+    }
+    /// Edge of a half-edge.
+    #[inline]
+    pub fn edge(&self, h: u32) -> u32 {
+        h >> 1
+    }
+    /// Half-edge `i` (0 or 1) of edge `e`.
+    #[inline]
+    pub fn edge_halfedge(&self, e: u32, i: u32) -> u32 {
+        2 * e + i
+    }
+    /// Face of a half-edge ([`NONE`] on a boundary).
+    #[inline]
+    pub fn face(&self, h: u32) -> u32 {
+        self.hface[h as usize]
+    }
+    /// An outgoing half-edge of `v` (a boundary one on a boundary; [`NONE`] if isolated).
+    #[inline]
+    pub fn vertex_halfedge(&self, v: u32) -> u32 {
+        self.vout[v as usize]
+    }
+    /// A half-edge of face `f`.
+    #[inline]
+    pub fn face_halfedge(&self, f: u32) -> u32 {
+        self.fhe[f as usize]
+    }
+    /// True for a half-edge without a face.
+    #[inline]
+    pub fn is_boundary_halfedge(&self, h: u32) -> bool {
+        self.hface[h as usize] == NONE
+    }
+    /// True for an edge with one face.
+    #[inline]
+    pub fn is_boundary_edge(&self, e: u32) -> bool {
+        self.hface[2 * e as usize] == NONE || self.hface[2 * e as usize + 1] == NONE
+    }
+    /// True for a vertex on a boundary (or isolated). O(1).
+    #[inline]
+    pub fn is_boundary_vertex(&self, v: u32) -> bool {
+        let h = self.vout[v as usize];
+        h == NONE || self.hface[h as usize] == NONE
+    }
+    /// True for a vertex without edges.
+    #[inline]
+    pub fn is_isolated(&self, v: u32) -> bool {
+        self.vout[v as usize] == NONE
+    }
+
+    /// Outgoing half-edges of `v`, rotating clockwise; a boundary vertex starts
+    /// with its boundary half-edge. O(1) per step.
+    pub fn outgoing(&self, v: u32) -> Outgoing<'_> {
+        let h = self.vout[v as usize];
+        Outgoing {
+            mesh: self,
+            start: h,
+            cur: h,
+        }
+    }
+    /// The 1-ring: neighbours of `v`, in the order of [`HalfedgeMesh::outgoing`].
+    pub fn neighbors(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        self.outgoing(v).map(move |h| self.to[h as usize])
+    }
+    /// Faces around `v`, in the order of [`HalfedgeMesh::outgoing`].
+    pub fn vertex_faces(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        self.outgoing(v)
+            .map(move |h| self.hface[h as usize])
+            .filter(|&f| f != NONE)
+    }
+    /// Number of edges at `v`.
+    pub fn valence(&self, v: u32) -> usize {
+        self.outgoing(v).count()
+    }
+
+    /// The three half-edges of face `f`, starting at its stored one.
+    #[inline]
+    pub fn face_halfedges(&self, f: u32) -> [u32; 3] {
+        let h0 = self.fhe[f as usize];
+        let h1 = self.next[h0 as usize];
+        [h0, h1, self.next[h1 as usize]]
+    }
+    /// The three corners of face `f` (targets of [`HalfedgeMesh::face_halfedges`]).
+    #[inline]
+    pub fn face_vertices(&self, f: u32) -> [u32; 3] {
+        self.face_halfedges(f).map(|h| self.to[h as usize])
+    }
+    /// The two ends of edge `e` (from and to of its half-edge `2e`).
+    #[inline]
+    pub fn edge_vertices(&self, e: u32) -> [u32; 2] {
+        [self.to[2 * e as usize + 1], self.to[2 * e as usize]]
+    }
+    /// The half-edge `a → b`, if any. O(valence of a).
+    pub fn find_halfedge(&self, a: u32, b: u32) -> Option<u32> {
+        self.outgoing(a).find(|&h| self.to[h as usize] == b)
+    }
+    /// Length of edge `e`.
+    pub fn edge_length(&self, e: u32) -> f64 {
+        let [a, b] = self.edge_vertices(e);
+        norm(sub(self.positions[a as usize], self.positions[b as usize]))
+    }
+    /// Twice the area vector of face `f` (right-handed around its corners).
+    pub fn face_normal2(&self, f: u32) -> [f64; 3] {
+        let [a, b, c] = self.face_vertices(f).map(|v| self.positions[v as usize]);
+        cross(sub(b, a), sub(c, a))
+    }
+
+    /// Makes the stored half-edge of `v` a boundary one if `v` has any.
+    fn adjust_outgoing(&mut self, v: u32) {
+        let mut found = NONE;
+        for h in self.outgoing(v) {
+            if self.hface[h as usize] == NONE {
+                found = h;
+                break;
+            }
+        }
+        if found != NONE {
+            self.vout[v as usize] = found;
+        }
+    }
+
+    /// Removes all tombstones, renumbering elements in their current order
+    /// (so the result is deterministic). Returns the old → new vertex map
+    /// ([`NONE`] for removed vertices). O(V + E + F).
+    pub fn compact(&mut self) -> Vec<u32> {
+        fn renumber(del: &[bool]) -> (Vec<u32>, usize) {
+            let mut map = vec![NONE; del.len()];
+            let mut n = 0;
+            for (i, &d) in del.iter().enumerate() {
+                if !d {
+                    map[i] = n as u32;
+                    n += 1;
+                }
+            }
+            (map, n)
+        }
+        fn keep<T: Copy>(v: &[T], del: &[bool]) -> Vec<T> {
+            v.iter()
+                .zip(del)
+                .filter(|(_, &d)| !d)
+                .map(|(x, _)| *x)
+                .collect()
+        }
+        let (vmap, _) = renumber(&self.vdel);
+        let (emap, _) = renumber(&self.edel);
+        let (fmap, _) = renumber(&self.fdel);
+        let hmap = |h: u32| {
+            if h == NONE {
+                NONE
+            } else {
+                2 * emap[(h >> 1) as usize] + (h & 1)
+            }
+        };
+        let fm = |f: u32| if f == NONE { NONE } else { fmap[f as usize] };
+        let hdel: Vec<bool> = (0..self.to.len()).map(|h| self.edel[h >> 1]).collect();
+        self.to = keep(&self.to, &hdel)
+            .into_iter()
+            .map(|v| vmap[v as usize])
+            .collect();
+        self.next = keep(&self.next, &hdel).into_iter().map(hmap).collect();
+        self.prev = keep(&self.prev, &hdel).into_iter().map(hmap).collect();
+        self.hface = keep(&self.hface, &hdel).into_iter().map(fm).collect();
+        self.vout = keep(&self.vout, &self.vdel).into_iter().map(hmap).collect();
+        self.fhe = keep(&self.fhe, &self.fdel).into_iter().map(hmap).collect();
+        self.positions = keep(&self.positions, &self.vdel);
+        self.vertex_size = keep(&self.vertex_size, &self.vdel);
+        self.vertex_flags = keep(&self.vertex_flags, &self.vdel);
+        self.vertex_origin = keep(&self.vertex_origin, &self.vdel);
+        self.vertex_hint = keep(&self.vertex_hint, &self.vdel);
+        self.edge_flags = keep(&self.edge_flags, &self.edel);
+        self.edge_line = keep(&self.edge_line, &self.edel);
+        self.face_patch = keep(&self.face_patch, &self.fdel);
+        self.vdel = vec![false; self.positions.len()];
+        self.edel = vec![false; self.edge_flags.len()];
+        self.fdel = vec![false; self.face_patch.len()];
+        self.deleted = [0; 3];
+        vmap
+    }
+
+    /// Plain arrays of the live mesh: vertices, triangles, and for each vertex
+    /// slot its output index ([`NONE`] for removed or isolated vertices).
+    ///
+    /// With `merge_locked`, [`V_LOCKED`] copies of one input vertex become one
+    /// output vertex again (they never move, so they still coincide), which
+    /// restores the input's non-manifold edges and vertices exactly.
+    pub fn to_arrays(&self, merge_locked: bool) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
+        let mut map = vec![NONE; self.n_vertices()];
+        let mut origin_map: std::collections::HashMap<u32, u32> = Default::default();
+        let mut verts = Vec::with_capacity(self.vertex_count());
+        for v in self.vertices() {
+            if self.is_isolated(v) {
+                continue;
+            }
+            let vi = v as usize;
+            let o = self.vertex_origin[vi];
+            if merge_locked && self.vertex_flags[vi] & V_LOCKED != 0 && o != NONE {
+                if let Some(&k) = origin_map.get(&o) {
+                    map[vi] = k;
+                    continue;
+                }
+                origin_map.insert(o, verts.len() as u32);
+            }
+            map[vi] = verts.len() as u32;
+            verts.push(self.positions[vi]);
+        }
+        let tris = self
+            .faces()
+            .map(|f| self.face_vertices(f).map(|v| map[v as usize]))
+            .collect();
+        (verts, tris, map)
+    }
+
+    /// Checks every connectivity invariant (for tests and debugging). O(V + E + F).
+    pub fn check(&self) -> Result<(), String> {
+        let nh = self.to.len() as u32;
+        for e in self.edges() {
+            for h in [2 * e, 2 * e + 1] {
+                let hu = h as usize;
+                let (n, p) = (self.next[hu], self.prev[hu]);
+                if n >= nh || p >= nh || self.edel[(n >> 1) as usize] || self.edel[(p >> 1) as usize]
+                {
+                    return Err(format!("half-edge {h}: bad next/prev"));
+                }
+                if self.prev[n as usize] != h || self.next[p as usize] != h {
+                    return Err(format!("half-edge {h}: next/prev not inverse"));
+                }
+                if self.from_vertex(n) != self.to[hu] {
+                    return Err(format!("half-edge {h}: next does not start at its end"));
+                }
+                let v = self.to[hu];
+                if self.vdel[v as usize] {
+                    return Err(format!("half-edge {h} points to deleted vertex {v}"));
+                }
+                let f = self.hface[hu];
+                if f != NONE {
+                    if self.fdel[f as usize] {
+                        return Err(format!("half-edge {h} in deleted face {f}"));
+                    }
+                    if self.hface[n as usize] != f || self.next[self.next[n as usize] as usize] != h
+                    {
+                        return Err(format!("face {f} is not a triangle"));
+                    }
+                }
+            }
+            if self.hface[2 * e as usize] == NONE && self.hface[2 * e as usize + 1] == NONE {
+                return Err(format!("edge {e} has no face"));
+            }
+            let [a, b] = self.edge_vertices(e);
+            if a == b {
+                return Err(format!("edge {e} is a loop"));
+            }
+        }
+        for f in self.faces() {
+            let h = self.fhe[f as usize];
+            if h == NONE || self.hface[h as usize] != f {
+                return Err(format!("face {f}: bad half-edge"));
+            }
+        }
+        let mut degree = vec![0usize; self.n_vertices()];
+        for e in self.edges() {
+            for v in self.edge_vertices(e) {
+                degree[v as usize] += 1;
+            }
+        }
+        for v in self.vertices() {
+            let h0 = self.vout[v as usize];
+            if h0 == NONE {
+                if degree[v as usize] > 0 {
+                    return Err(format!("vertex {v}: edges but no half-edge"));
+                }
+                continue;
+            }
+            if self.from_vertex(h0) != v {
+                return Err(format!("vertex {v}: stored half-edge does not start there"));
+            }
+            let mut boundary = 0;
+            let mut seen = std::collections::HashSet::new();
+            let mut count = 0usize;
+            for h in self.outgoing(v) {
+                count += 1;
+                if count > self.to.len() {
+                    return Err(format!("vertex {v}: fan does not close"));
+                }
+                if self.from_vertex(h) != v {
+                    return Err(format!("vertex {v}: fan leaves the vertex"));
+                }
+                if !seen.insert(self.to[h as usize]) {
+                    return Err(format!("vertex {v}: repeated neighbour"));
+                }
+                if self.hface[h as usize] == NONE {
+                    boundary += 1;
+                }
+            }
+            if count != degree[v as usize] {
+                return Err(format!("vertex {v}: {count} edges in its fan, {} in all", degree[v as usize]));
+            }
+            if boundary > 1 || (boundary == 1 && self.hface[h0 as usize] != NONE) {
+                return Err(format!("vertex {v}: non-manifold or stale boundary half-edge"));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,576 @@
+//! Isotropic remeshing of a grid into the dense background grid (DESIGN §3.1),
+//! after Botsch & Kobbelt (2004) and Dunyach et al. (2013).
+//!
+//! Each iteration: split edges longer than 4/3·L, collapse edges shorter than
+//! 4/5·L, flip edges towards valence 6 (4 on a boundary), then tangential
+//! relaxation with projection onto the **input** surface (exact closest point,
+//! restricted to the vertex's own smooth patch, or to its own input feature
+//! line for a vertex on a feature). L is the local target length: a uniform
+//! length (default diagonal/100) or the sizes of a sizing grid, capped where the
+//! surface bends at half the curvature size `π / (κ · n_circle)` (optional).
+//!
+//! Features (dihedral angle above 30°, boundaries, non-manifold edges) are kept
+//! as constrained polylines; corners (feature valence ≠ 2, or a line turning by
+//! more than the corner angle) never move and are never removed. Bodies stay
+//! apart; non-manifold edges (touching bodies) are locked, never changed, and
+//! their vertices never move, so the output has the same bodies and no new
+//! boundary or non-manifold edges. Dirty input (slivers, open surfaces,
+//! inconsistent orientation) is handled without panicking; what could not be
+//! remeshed is listed in [`RemeshReport::issues`].
+//!
+//! Cost: O(F log F) per iteration (projection dominates), parallel (rayon) in
+//! relaxation and projection; the topological passes are sequential. The
+//! output does not depend on the thread count.
+
+mod field;
+mod locked;
+mod ops;
+pub mod quality;
+pub mod reference;
+mod smooth;
+
+use crate::error::{Error, Result};
+use crate::mesh::halfedge::{BuildReport, HalfedgeMesh, E_LOCKED, NONE, V_CORNER, V_FEATURE};
+use crate::mesh::{BuildOptions, Features, Grid};
+use ops::Limits;
+use reference::Reference;
+use std::time::Instant;
+
+/// How the uniform target edge length is given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TargetLength {
+    /// In model units.
+    Absolute(f64),
+    /// As a fraction of the bounding-box diagonal.
+    Relative(f64),
+}
+
+/// Parameters of [`remesh`] and [`remesh_sized`]. `Default` gives the documented defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RemeshParams {
+    /// Uniform target edge length L0 (default `Relative(0.01)`: diagonal / 100).
+    /// Ignored by [`remesh_sized`].
+    pub target: TargetLength,
+    /// Dihedral angle above which an edge is a feature, degrees (30).
+    pub feature_angle_deg: f64,
+    /// A feature line turning by more than this at a vertex has a corner there, degrees (30).
+    pub corner_angle_deg: f64,
+    /// Split / collapse / flip / relax iterations (10).
+    pub iterations: usize,
+    /// Relaxation steps per iteration, each followed by projection (2).
+    pub relax_steps: usize,
+    /// Cap the target locally at half the curvature size, `π / (κ · n_circle)`
+    /// (true), so small fillets are resolved.
+    pub curvature_limit: bool,
+    /// Elements per full circle in the curvature size (24).
+    pub n_circle: f64,
+    /// The curvature cap never goes below this fraction of the base length (0.1).
+    pub min_length_ratio: f64,
+    /// The cap from the curvature of a feature line never goes below this
+    /// fraction of the base length (0.02): a tight curve of a feature line
+    /// (a wing tip's outline) costs little and is cut badly by long chords.
+    pub line_min_length_ratio: f64,
+    /// Largest growth of the curvature cap per unit distance (0.3).
+    pub gradation: f64,
+    /// Largest turn of a face normal an operation may cause, degrees (60).
+    pub max_normal_turn_deg: f64,
+    /// Smallest angle a collapse may create unless the faces it replaces were
+    /// already worse, degrees (10).
+    pub sliver_angle_deg: f64,
+    /// A collapse may remove a vertex only if it lies within this fraction of
+    /// the local target length of the surface (and feature line) left (0.05).
+    pub fidelity: f64,
+}
+
+impl Default for RemeshParams {
+    fn default() -> Self {
+        RemeshParams {
+            target: TargetLength::Relative(0.01),
+            feature_angle_deg: 30.0,
+            corner_angle_deg: 30.0,
+            iterations: 10,
+            relax_steps: 2,
+            curvature_limit: true,
+            n_circle: 24.0,
+            min_length_ratio: 0.1,
+            line_min_length_ratio: 0.02,
+            gradation: 0.3,
+            max_normal_turn_deg: 60.0,
+            sliver_angle_deg: 10.0,
+            fidelity: 0.05,
+        }
+    }
+}
+
+/// Counts of one iteration.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct IterationReport {
+    /// Edges split.
+    pub splits: usize,
+    /// Edges collapsed.
+    pub collapses: usize,
+    /// Edges flipped.
+    pub flips: usize,
+    /// Vertices whose relaxation move was cut back (it would have folded a face).
+    pub cut_moves: usize,
+    /// Vertices after the iteration.
+    pub vertices: usize,
+    /// Faces after the iteration.
+    pub faces: usize,
+    /// Seconds spent.
+    pub seconds: f64,
+}
+
+/// What [`remesh`] did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RemeshReport {
+    /// Vertices of the input.
+    pub vertices_in: usize,
+    /// Faces of the input.
+    pub faces_in: usize,
+    /// Vertices of the output.
+    pub vertices_out: usize,
+    /// Faces of the output.
+    pub faces_out: usize,
+    /// Uniform target length L0 (NaN in size-driven mode).
+    pub target_length: f64,
+    /// Smallest and largest target length over the output vertices.
+    pub target_range: [f64; 2],
+    /// Feature edges of the input.
+    pub feature_edges_in: usize,
+    /// Feature lines (chains of feature edges between corners, or loops).
+    pub feature_lines: usize,
+    /// Smooth patches narrower than half their target length, remeshed from
+    /// their rims only (no vertices inside).
+    pub thin_patches: usize,
+    /// Corners (fixed vertices), counting copies at non-manifold vertices.
+    pub corners: usize,
+    /// How the input was made manifold for local operations.
+    pub build: BuildReport,
+    /// One entry per iteration.
+    pub iterations: Vec<IterationReport>,
+    /// Flips of the final angle clean-up.
+    pub final_flips: usize,
+    /// Total seconds.
+    pub seconds: f64,
+    /// What could not be remeshed, and why (empty when everything was).
+    pub issues: Vec<String>,
+}
+
+/// A remeshed grid and its report.
+#[derive(Debug, Clone)]
+pub struct Remeshed {
+    /// The new grid (no sizes).
+    pub grid: Grid,
+    /// The feature edges kept (vertex pairs of `grid`): the constrained
+    /// polylines along the input's feature lines, boundaries and non-manifold
+    /// edges.
+    pub feature_edges: Vec<[u32; 2]>,
+    /// What was done.
+    pub report: RemeshReport,
+}
+
+/// Uniform isotropic remeshing of `input` with target length `params.target`
+/// (capped by curvature when `params.curvature_limit`). Errors on invalid
+/// parameters or when nothing is left.
+pub fn remesh(input: &Grid, params: &RemeshParams) -> Result<Remeshed> {
+    let diag = input.bbox().diagonal();
+    let l0 = match params.target {
+        TargetLength::Absolute(l) => l,
+        TargetLength::Relative(r) => r * diag,
+    };
+    if !(l0.is_finite() && l0 > 0.0) {
+        return Err(Error::InvalidArgument(format!(
+            "target edge length {l0} must be finite and > 0"
+        )));
+    }
+    run(input, None, Some(l0), params)
+}
+
+/// Size-driven remeshing: the target length at a point is the size `sizing`
+/// gives there ([`Grid::query_size`]), capped by curvature when
+/// `params.curvature_limit`. `sizing` must carry sizes (it may be `input`).
+pub fn remesh_sized(input: &Grid, sizing: &Grid, params: &RemeshParams) -> Result<Remeshed> {
+    if sizing.sizes().is_none() {
+        return Err(Error::InvalidArgument("the sizing grid has no sizes".into()));
+    }
+    run(input, Some(sizing), None, params)
+}
+
+fn check(params: &RemeshParams) -> Result<()> {
+    let within = |x: f64, lo: f64, hi: f64, what: &str| -> Result<()> {
+        if x.is_finite() && x >= lo && x <= hi {
+            Ok(())
+        } else {
+            Err(Error::InvalidArgument(format!(
+                "{what} = {x} must be in [{lo}, {hi}]"
+            )))
+        }
+    };
+    within(params.feature_angle_deg, 0.0, 180.0, "feature_angle_deg")?;
+    within(params.corner_angle_deg, 0.0, 180.0, "corner_angle_deg")?;
+    within(params.n_circle, 1e-9, 1e9, "n_circle")?;
+    within(params.min_length_ratio, 0.0, 1.0, "min_length_ratio")?;
+    within(params.line_min_length_ratio, 0.0, 1.0, "line_min_length_ratio")?;
+    within(params.gradation, 0.0, 1e9, "gradation")?;
+    within(params.max_normal_turn_deg, 0.0, 180.0, "max_normal_turn_deg")?;
+    within(params.sliver_angle_deg, 0.0, 60.0, "sliver_angle_deg")?;
+    within(params.fidelity, 0.0, 1e9, "fidelity")
+}
+
+fn run(
+    input: &Grid,
+    sizing: Option<&Grid>,
+    l0: Option<f64>,
+    params: &RemeshParams,
+) -> Result<Remeshed> {
+    check(params)?;
+    let start = Instant::now();
+    let features = Features::detect(input, params.feature_angle_deg);
+    let (mut mesh, build) = HalfedgeMesh::from_grid(input, Some(&features));
+    let base: Vec<f64> = match (l0, sizing) {
+        (Some(l), _) => vec![l; input.vertices().len()],
+        (None, Some(g)) => input
+            .vertices()
+            .iter()
+            .map(|&p| g.closest(p, None).map_or(f64::INFINITY, |h| h.size))
+            .collect(),
+        (None, None) => vec![f64::INFINITY; input.vertices().len()],
+    };
+    let cap = field::length_cap(
+        input,
+        &features,
+        &field::CapSettings {
+            base,
+            crease_tolerance: params.fidelity,
+            curvature: params.curvature_limit,
+            n_circle: params.n_circle,
+            min_ratio: params.min_length_ratio,
+            line_min_ratio: params.line_min_length_ratio,
+            corner_deg: params.corner_angle_deg,
+        },
+    );
+    // Only caps below the uniform length matter.
+    let cap: Vec<f64> = cap
+        .into_iter()
+        .map(|c| if l0.is_some_and(|l| c >= l) { f64::INFINITY } else { c })
+        .collect();
+    let cap = field::PointField::new(input.vertices(), &cap, params.gradation);
+    let edge_is_feature: Vec<bool> = features.edge_flags.iter().map(|&f| f != 0).collect();
+    {
+        let no_lines = reference::FeatureLines::default();
+        let sizes = Reference {
+            grid: input,
+            face_patch: &features.face_patch,
+            edge_is_feature: &edge_is_feature,
+            thin_patch: &[],
+            lines: &no_lines,
+            base: l0,
+            cap: &cap,
+            sizing,
+        };
+        locked::presplit(&mut mesh, |p| sizes.target(p), input.vertices().len() as u32);
+    }
+    let (lines, _) = reference::feature_lines(&mut mesh, params.corner_angle_deg);
+    let mut reference = Reference {
+        grid: input,
+        face_patch: &features.face_patch,
+        edge_is_feature: &edge_is_feature,
+        thin_patch: &[],
+        lines: &lines,
+        base: l0,
+        cap: &cap,
+        sizing,
+    };
+    let thin = thin_patches(input, &features, &reference);
+    reference.thin_patch = &thin;
+    let thin_patches = thin.iter().filter(|&&x| x).count();
+    let lim = Limits {
+        cos_turn: params.max_normal_turn_deg.to_radians().cos(),
+        sliver_deg: params.sliver_angle_deg,
+        fidelity: params.fidelity,
+        cos_crease: params.feature_angle_deg.min(20.0).to_radians().cos(),
+    };
+    // Sizes of corners (fixed) and everyone else (by projection).
+    for v in 0..mesh.n_vertices() {
+        mesh.vertex_size[v] = reference.target(mesh.positions[v]);
+    }
+    smooth::relax_and_project(&mut mesh, &reference, false, lim.cos_turn);
+
+    let mut report = RemeshReport {
+        vertices_in: input.vertices().len(),
+        faces_in: input.triangles().len(),
+        target_length: l0.unwrap_or(f64::NAN),
+        feature_edges_in: features.feature_edge_count(),
+        feature_lines: lines.line_count as usize,
+        thin_patches,
+        corners: mesh
+            .vertices()
+            .filter(|&v| mesh.vertex_flags[v as usize] & V_CORNER != 0)
+            .count(),
+        build,
+        ..Default::default()
+    };
+    let dbg = std::env::var_os("REMESH_DEBUG").is_some();
+    let t_setup = start.elapsed();
+    if dbg {
+        eprintln!("setup {t_setup:?}");
+    }
+    if dbg {
+        let s: Vec<f64> = mesh.vertex_size.clone();
+        eprintln!("l0 {l0:?} sizes min {} max {}", s.iter().cloned().fold(f64::INFINITY, f64::min), s.iter().cloned().fold(0.0, f64::max));
+    }
+    let zero = |mesh: &HalfedgeMesh| {
+        let n = mesh.faces()
+            .filter(|&f| {
+                let [a, b, c] = mesh.face_vertices(f).map(|v| mesh.positions[v as usize]);
+                ops::flatness(a, b, c) <= 1e-4
+            })
+            .count();
+        let locked: Vec<[[f64; 3]; 2]> = mesh.edges().filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED != 0).map(|e| mesh.edge_vertices(e).map(|v| mesh.positions[v as usize])).collect();
+        let on: Vec<u32> = mesh.vertices().filter(|&v| mesh.vertex_flags[v as usize] == 0 && locked.iter().any(|s| {
+            let p = mesh.positions[v as usize];
+            let t = crate::geometry::closest_point_on_segment(p, s[0], s[1]);
+            crate::geometry::dist2(p, crate::geometry::lerp(s[0], s[1], t)) < 1e-18
+        })).collect();
+        let pp: u32 = std::env::var("PATCH").ok().and_then(|x| x.parse().ok()).unwrap_or(u32::MAX);
+        let rims: Vec<[[f64; 3]; 2]> = mesh.edges().filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED != 0 && [2*e, 2*e+1].iter().any(|&h| { let f = mesh.face(h); f != NONE && mesh.face_patch[f as usize] == pp })).map(|e| mesh.edge_vertices(e).map(|v| mesh.positions[v as usize])).collect();
+        let mut onrim = 0;
+        let mut nfp = 0;
+        for f in mesh.faces() {
+            if mesh.face_patch[f as usize] != pp { continue; }
+            nfp += 1;
+            for v in mesh.face_vertices(f) {
+                if mesh.vertex_flags[v as usize] == 0 {
+                    let p = mesh.positions[v as usize];
+                    if rims.iter().any(|s| { let t = crate::geometry::closest_point_on_segment(p, s[0], s[1]); crate::geometry::dist2(p, crate::geometry::lerp(s[0], s[1], t)) < 1e-6 }) { onrim += 1; }
+                }
+            }
+        }
+        format!("{n} free-on-locked {} patch faces {nfp} on-rim {onrim}", on.len())
+    };
+    if dbg {
+        eprintln!("zero at start {}", zero(&mesh));
+    }
+    for _ in 0..params.iterations {
+        let t = Instant::now();
+        let splits = ops::split_long(&mut mesh, &reference, &lim);
+        if dbg { eprintln!("splits {splits} {:?} zero {}", t.elapsed(), zero(&mesh)); mesh.check().unwrap(); }
+        let collapses = ops::collapse_short(&mut mesh, &lim);
+        if dbg { eprintln!("collapses {collapses} {:?} zero {}", t.elapsed(), zero(&mesh)); mesh.check().unwrap(); }
+        let repaired = ops::repair_flat(&mut mesh, &lim, 0.02);
+        if dbg { eprintln!("repaired {repaired} zero {}", zero(&mesh)); }
+        let flips = ops::flip_valence(&mut mesh, &lim);
+        if dbg { eprintln!("flips {flips} {:?} zero {}", t.elapsed(), zero(&mesh)); mesh.check().unwrap(); }
+        let mut it = IterationReport {
+            splits,
+            collapses: collapses + repaired,
+            flips,
+            ..Default::default()
+        };
+        for k in 0..params.relax_steps.max(1) {
+            let relax = params.relax_steps > 0 || k > 0;
+            it.cut_moves += smooth::relax_and_project(&mut mesh, &reference, relax, lim.cos_turn);
+        }
+        mesh.compact();
+        if dbg {
+            eprintln!("relax zero {}", zero(&mesh));
+        }
+        it.vertices = mesh.vertex_count();
+        it.faces = mesh.face_count();
+        it.seconds = t.elapsed().as_secs_f64();
+        report.iterations.push(it);
+    }
+    report.final_flips = ops::flip_angles(&mut mesh, &lim, 3);
+    report.final_flips += ops::repair_flat(&mut mesh, &lim, 0.02);
+    smooth::relax_and_project(&mut mesh, &reference, false, lim.cos_turn);
+    mesh.compact();
+
+    if dbg {
+        let mut n = 0;
+        for f in mesh.faces() {
+            let vs = mesh.face_vertices(f);
+            let [a, b, c] = vs.map(|v| mesh.positions[v as usize]);
+            let (ab, ac, bc) = (crate::geometry::sub(b, a), crate::geometry::sub(c, a), crate::geometry::sub(c, b));
+            let l2 = crate::geometry::norm2(ab).max(crate::geometry::norm2(ac)).max(crate::geometry::norm2(bc));
+            if crate::geometry::norm(crate::geometry::cross(ab, ac)) <= 1e-4 * l2 {
+                n += 1;
+                if n % 1000 == 1 {
+                    let fl = vs.map(|v| mesh.vertex_flags[v as usize]);
+                    let hs = mesh.face_halfedges(f).map(|h| mesh.edge_flags[mesh.edge(h) as usize]);
+                    eprintln!("zero face {f} {vs:?} flags {fl:?} edges {hs:?} pos {:?} {:?} {:?} l2 {l2:e} patch {} sizes {:?}", a, b, c, mesh.face_patch[f as usize], vs.map(|v| mesh.vertex_size[v as usize]));
+                }
+            }
+        }
+        eprintln!("{n} zero faces");
+        let mut kinds = std::collections::BTreeMap::new();
+        for f in mesh.faces() {
+            let hs = mesh.face_halfedges(f);
+            let vs = mesh.face_vertices(f);
+            let [a, b, c] = vs.map(|v| mesh.positions[v as usize]);
+            if ops::flatness(a, b, c) > 1e-4 { continue; }
+            // longest edge
+            let lens: Vec<(f64, u32)> = hs.iter().map(|&h| (mesh.edge_length(mesh.edge(h)), h)).collect();
+            let (lmax, hmax) = lens.iter().cloned().fold((0.0, 0), |x, y| if y.0 > x.0 { y } else { x });
+            let lmin = lens.iter().map(|x| x.0).fold(f64::INFINITY, f64::min);
+            let needle = lmin < 0.1 * lmax;
+            let ef = mesh.edge_flags[mesh.edge(hmax) as usize];
+            let apex = mesh.to_vertex(mesh.next(hmax));
+            let key = format!("{} long-edge-flags {} apex-flags {} flat-neighbour {}", if needle {"needle"} else {"cap"}, ef, mesh.vertex_flags[apex as usize], {
+                let o = mesh.face(hmax ^ 1);
+                if o == NONE { "none".to_string() } else { let [x,y,z] = mesh.face_vertices(o).map(|v| mesh.positions[v as usize]); (ops::flatness(x,y,z) < 1e-4).to_string() }
+            });
+            *kinds.entry(key).or_insert(0) += 1;
+        }
+        for (k, n) in kinds { eprintln!("  {n:6} {k}"); }
+        if let Ok(pp) = std::env::var("PATCH") {
+            let pp: u32 = pp.parse().unwrap();
+            for (f, t) in input.triangles().iter().enumerate() {
+                if features.face_patch[f] == pp {
+                    eprintln!("input f{f} {:?} edges {:?}", t.map(|v| input.vertices()[v as usize]), input.topology().face_edges[f].map(|e| features.edge_flags[e as usize]));
+                }
+            }
+            let mut bb = crate::geometry::Aabb::EMPTY;
+            let mut nf = 0;
+            let mut nflat = 0;
+            for f in mesh.faces() {
+                if mesh.face_patch[f as usize] == pp {
+                    nf += 1;
+                    let vs = mesh.face_vertices(f);
+                    let [a, b, c] = vs.map(|v| mesh.positions[v as usize]);
+                    if ops::flatness(a, b, c) < 1e-4 { nflat += 1; if nflat < 6 { eprintln!("  flat {:?} flags {:?}", [a,b,c], vs.map(|v| mesh.vertex_flags[v as usize])); } }
+                    for p in [a, b, c] { bb.grow(&p); }
+                }
+            }
+            eprintln!("output patch {pp}: {nf} faces ({nflat} flat), bbox {bb:?}");
+        }
+    }
+    let sizes: Vec<f64> = mesh.vertices().map(|v| mesh.vertex_size[v as usize]).collect();
+    report.target_range = [
+        sizes.iter().copied().fold(f64::INFINITY, f64::min),
+        sizes.iter().copied().fold(0.0, f64::max),
+    ];
+    report.issues = issues(&mesh, &report);
+    let (verts, tris, map) = mesh.to_arrays(true);
+    let feature_edges: Vec<[u32; 2]> = mesh
+        .edges()
+        .filter(|&e| mesh.edge_flags[e as usize] & crate::mesh::halfedge::E_FEATURE != 0)
+        .map(|e| mesh.edge_vertices(e).map(|v| map[v as usize]))
+        .collect();
+    let grid = Grid::from_arrays(
+        verts,
+        tris,
+        None,
+        &BuildOptions {
+            weld_relative_tolerance: None,
+            orient: false,
+        },
+    )?;
+    if grid.report().dropped_zero_area > 0 {
+        report.issues.push(format!(
+            "{} zero-area triangles were dropped from the output",
+            grid.report().dropped_zero_area
+        ));
+    }
+    report.vertices_out = grid.vertices().len();
+    report.faces_out = grid.triangles().len();
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok(Remeshed {
+        grid,
+        feature_edges,
+        report,
+    })
+}
+
+/// Patches narrower than half their target length (twice the area over the
+/// perimeter): such a strip cannot hold vertices inside (they would sit on
+/// its rims and make flat faces), so it is remeshed from its rims only.
+fn thin_patches(input: &Grid, features: &Features, reference: &Reference) -> Vec<bool> {
+    let np = features.patch_count as usize;
+    let (v, t, topo) = (input.vertices(), input.triangles(), input.topology());
+    let mut area = vec![0.0; np];
+    let mut perimeter = vec![0.0; np];
+    let mut target = vec![f64::INFINITY; np];
+    let vt: Vec<f64> = v.iter().map(|&p| reference.target(p)).collect();
+    for (f, tri) in t.iter().enumerate() {
+        let p = features.face_patch[f] as usize;
+        let [a, b, c] = tri.map(|i| v[i as usize]);
+        area[p] += crate::geometry::triangle_area(a, b, c);
+        for &i in tri {
+            target[p] = target[p].min(vt[i as usize]);
+        }
+        for &e in &topo.face_edges[f] {
+            if features.is_feature(e as usize) {
+                let [x, y] = topo.edges[e as usize];
+                perimeter[p] += crate::geometry::dist2(v[x as usize], v[y as usize]).sqrt();
+            }
+        }
+    }
+    (0..np)
+        .map(|p| perimeter[p] > 0.0 && 2.0 * area[p] / perimeter[p] < 0.5 * target[p])
+        .collect()
+}
+
+/// The list of what was left as it was, and why.
+fn issues(mesh: &HalfedgeMesh, report: &RemeshReport) -> Vec<String> {
+    let mut out = Vec::new();
+    let b = &report.build;
+    if b.split_vertices > 0 {
+        out.push(format!(
+            "{} non-manifold vertices (bodies touching) were split into {} extra copies; \
+             they never move",
+            b.split_vertices, b.extra_copies
+        ));
+    }
+    let locked = mesh
+        .edges()
+        .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED != 0)
+        .count();
+    if locked > 0 {
+        out.push(format!(
+            "{locked} locked edges (non-manifold in the input: bodies touching along them, \
+             or orientation seams) were kept as they are"
+        ));
+    }
+    if report.thin_patches > 0 {
+        out.push(format!(
+            "{} smooth patches are narrower than half the target length (strips): they \
+             hold no vertices inside, so their triangles are as long as the strip is narrow",
+            report.thin_patches
+        ));
+    }
+    if b.detached_faces > 0 {
+        out.push(format!(
+            "{} faces conflicting in orientation with a neighbour were kept as they are",
+            b.detached_faces
+        ));
+    }
+    let bad = mesh
+        .faces()
+        .filter(|&f| {
+            let [a, bb, c] = mesh.face_vertices(f).map(|v| mesh.positions[v as usize]);
+            ops::min_angle_deg(a, bb, c) < 5.0
+        })
+        .count();
+    if bad > 0 {
+        let at_features = mesh
+            .faces()
+            .filter(|&f| {
+                let vs = mesh.face_vertices(f);
+                let [a, bb, c] = vs.map(|v| mesh.positions[v as usize]);
+                ops::min_angle_deg(a, bb, c) < 5.0
+                    && vs
+                        .iter()
+                        .all(|&v| mesh.vertex_flags[v as usize] & V_FEATURE != 0)
+            })
+            .count();
+        out.push(format!(
+            "{bad} faces have an angle below 5° ({at_features} of them between feature \
+             vertices only, where short feature segments or acute corners force them)"
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;
