@@ -1,15 +1,23 @@
 //! The cap on the target edge length: per input vertex, half the curvature
 //! size `h = 2π / (κ · n_circle)` where the surface or a feature line bends,
 //! and a crease size where two input facets meet at an angle below the
-//! feature angle; then spread as a graded field of point sources, so it grows
-//! by at most `slope` per unit distance (abrupt jumps make bad triangles).
+//! feature angle; then spread as a graded field of sources (points on
+//! feature lines, crease edges, curved input faces), so it grows by at most
+//! `slope` per unit distance (abrupt jumps make bad triangles). Sources are
+//! whole edges and faces, not only vertices: CAD tessellations have needle
+//! triangles hundreds of target lengths long whose curvature (a fillet along
+//! a panel) must reach their middle, not only their corners.
 
-use crate::geometry::{dot, norm, sub};
+use crate::geometry::{closest_point_triangle, dot, norm, sub};
 use crate::mesh::{Features, Grid};
-use crate::sizing::curvature::principal_curvatures;
+use crate::sizing::curvature::patch_curvatures;
 use crate::sizing::normals::PatchNormals;
 use crate::spatial::{Bvh, MAX_DEPTH};
 use std::f64::consts::PI;
+
+/// Target length across a strip of width w: `STRIP_RATIO · w` (triangles
+/// spanning it are then about equilateral).
+const STRIP_RATIO: f64 = 1.2;
 
 /// Settings of [`length_cap`].
 #[derive(Debug, Clone)]
@@ -33,12 +41,17 @@ pub struct CapSettings {
     pub corner_deg: f64,
 }
 
-/// The cap per input vertex (∞ where nothing limits it). O(V).
-pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<f64> {
+/// A source of the cap: a point, segment or triangle (repeated corners) and
+/// the cap on it.
+pub type Source = ([[f64; 3]; 3], f64);
+
+/// The cap sources (only finite caps). O(F).
+pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Source> {
     let nv = grid.vertices().len();
     let mut cap = vec![f64::INFINITY; nv];
+    let mut out: Vec<Source> = Vec::new();
     if !s.curvature {
-        return cap;
+        return out;
     }
     let floor = |v: usize| s.min_ratio * s.base[v];
     let from_kappa = |k: f64, floor: f64| -> f64 {
@@ -49,16 +62,98 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<f64>
         }
     };
     let normals = PatchNormals::compute(grid, features);
-    let curv = principal_curvatures(grid, features, &normals);
-    for v in 0..nv {
-        cap[v] = cap[v].min(from_kappa(curv[v].max_abs(), floor(v)));
+    let per_patch = patch_curvatures(grid, features, &normals);
+    for vi in 0..nv {
+        for e in normals.range(vi) {
+            cap[vi] = cap[vi].min(from_kappa(per_patch[e].max_abs(), floor(vi)));
+        }
+    }
+    let v = grid.vertices();
+    let tris = grid.triangles();
+    let topo = grid.topology();
+    // Each face whose corners all bend in its patch is a source too, with the
+    // smallest of their curvatures: a fillet tessellated by needles then
+    // limits the length along its whole span, not only near its corners,
+    // while a flat face fanned from a curved rim stays free (its corners'
+    // curvature in its own patch is zero).
+    let entry = |vi: usize, patch: u32| {
+        let r = normals.range(vi);
+        normals.patch[r.clone()]
+            .iter()
+            .position(|&p| p == patch)
+            .map(|k| r.start + k)
+    };
+    for (f, t) in tris.iter().enumerate() {
+        let patch = features.face_patch[f];
+        let k = t
+            .iter()
+            .map(|&i| entry(i as usize, patch).map_or(0.0, |e| per_patch[e].max_abs()))
+            .fold(f64::INFINITY, f64::min);
+        let floor_f = t.iter().map(|&i| floor(i as usize)).fold(f64::INFINITY, f64::min);
+        let c = from_kappa(k, floor_f);
+        if c.is_finite() {
+            out.push((t.map(|i| v[i as usize]), c));
+        }
+    }
+    // Strips: a smooth patch narrower than its target length (a plate's rim
+    // between two sharp edges) is meshed across its width, so its rims are
+    // refined to about that width and the triangles spanning it are not
+    // slivers. Width: twice the area over
+    // the perimeter (exact for a long strip, the radius of a disc).
+    {
+        let np = features.patch_count as usize;
+        let mut area = vec![0.0; np];
+        let mut perimeter = vec![0.0; np];
+        let mut base = vec![f64::INFINITY; np];
+        for (f, t) in tris.iter().enumerate() {
+            let p = features.face_patch[f] as usize;
+            area[p] += crate::geometry::triangle_area(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
+            for &i in t {
+                base[p] = base[p].min(s.base[i as usize]);
+            }
+            for &e in &topo.face_edges[f] {
+                if features.is_feature(e as usize) {
+                    let [a, b] = topo.edges[e as usize];
+                    perimeter[p] += norm(sub(v[a as usize], v[b as usize]));
+                }
+            }
+        }
+        let width = |p: usize| {
+            if perimeter[p] > 0.0 {
+                2.0 * area[p] / perimeter[p]
+            } else {
+                f64::INFINITY
+            }
+        };
+        let floor_p = |p: usize| s.line_min_ratio * base[p];
+        // Strips narrower than the floor (a foil's edge) are left unrefined,
+        // and so are the strips beside them: refining a rim they share would
+        // only multiply the slivers spanning the narrower one.
+        let mut beside_foil = vec![false; np];
+        for e in 0..topo.edges.len() {
+            let fs = topo.faces_of_edge(e);
+            for &a in fs {
+                for &b in fs {
+                    let (pa, pb) = (features.face_patch[a as usize] as usize, features.face_patch[b as usize] as usize);
+                    if pa != pb && STRIP_RATIO * width(pb) < floor_p(pb) {
+                        beside_foil[pa] = true;
+                    }
+                }
+            }
+        }
+        for (f, t) in tris.iter().enumerate() {
+            let p = features.face_patch[f] as usize;
+            let c = STRIP_RATIO * width(p);
+            if c < base[p] && c >= floor_p(p) && !beside_foil[p] {
+                out.push((t.map(|i| v[i as usize]), c));
+            }
+        }
     }
     // Creases below the feature angle: a chord of length L across a crease of
     // angle φ cuts off about L·φ/4, so L ≤ 4·tolerance·base/φ keeps the cut
     // within tolerance. (Curvature fits see a crease between large facets as
     // a gentle bend.)
     let fnormal = &normals.face_normal;
-    let topo = grid.topology();
     for e in 0..topo.edges.len() {
         let fs = topo.faces_of_edge(e);
         if fs.len() != 2 || features.is_feature(e) {
@@ -68,15 +163,13 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<f64>
             .clamp(-1.0, 1.0)
             .acos();
         if phi > 1e-3 {
-            for &v in &topo.edges[e] {
-                let v = v as usize;
-                let l = (4.0 * s.crease_tolerance * s.base[v] / phi).max(floor(v));
-                cap[v] = cap[v].min(l);
-            }
+            let [a, b] = topo.edges[e].map(|i| i as usize);
+            let l = (4.0 * s.crease_tolerance * s.base[a].min(s.base[b]) / phi)
+                .max(floor(a).min(floor(b)));
+            out.push(([v[a], v[b], v[b]], l));
         }
     }
     // Curvature of feature lines: turning angle over the mean segment length.
-    let v = grid.vertices();
     let cos_c = s.corner_deg.to_radians().cos();
     let mut ends: Vec<u32> = Vec::new();
     for (vi, c) in cap.iter_mut().enumerate() {
@@ -112,36 +205,41 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<f64>
         let k = cos.acos() / (0.5 * (l1 + l2));
         *c = c.min(from_kappa(k, s.line_min_ratio * s.base[vi]));
     }
-    cap
+    for (vi, &c) in cap.iter().enumerate() {
+        if c.is_finite() {
+            out.push(([v[vi]; 3], c));
+        }
+    }
+    out
 }
 
-/// A graded size field from point sources: `f(x) = min_i (h_i + slope·|x − p_i|)`
-/// (∞ without sources), evaluated exactly by branch and bound over a BVH of
-/// the points with the smallest value per node. Unlike values interpolated on
-/// the input triangles, it grows away from a small source whatever the input
-/// tessellation (a planar face tessellated only at its rim still gets large
-/// elements inside).
+/// A graded size field from sources: `f(x) = min_i (h_i + slope·d(x, S_i))`
+/// (∞ without sources) with `S_i` a point, segment or triangle, evaluated
+/// exactly by branch and bound over a BVH of the sources with the smallest
+/// value per node. Unlike values interpolated on the input triangles, it grows
+/// away from a small source whatever the input tessellation (a planar face
+/// tessellated only at its rim still gets large elements inside).
 #[derive(Debug, Clone, Default)]
-pub struct PointField {
+pub struct SourceField {
     bvh: Bvh,
     value: Vec<f64>,
     node_min: Vec<f64>,
     slope: f64,
 }
 
-impl PointField {
-    /// The field of `points` with `values` (non-finite values are ignored) and
-    /// growth `slope` (> 0). O(n log n).
-    pub fn new(points: &[[f64; 3]], values: &[f64], slope: f64) -> PointField {
-        let keep: Vec<usize> = (0..points.len())
-            .filter(|&i| values[i].is_finite())
+impl SourceField {
+    /// The field of `sources` (non-finite values are ignored) and growth
+    /// `slope` (> 0). O(n log n).
+    pub fn new(sources: &[Source], slope: f64) -> SourceField {
+        let keep: Vec<&Source> = sources.iter().filter(|s| s.1.is_finite()).collect();
+        let pts: Vec<[f64; 3]> = keep.iter().flat_map(|s| s.0).collect();
+        let value: Vec<f64> = keep.iter().map(|s| s.1).collect();
+        let tris: Vec<[u32; 3]> = (0..keep.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
             .collect();
-        let pts: Vec<[f64; 3]> = keep.iter().map(|&i| points[i]).collect();
-        let value: Vec<f64> = keep.iter().map(|&i| values[i]).collect();
-        let tris: Vec<[u32; 3]> = (0..pts.len() as u32).map(|i| [i, i, i]).collect();
         let bvh = Bvh::build(&pts, &tris);
         let node_min = bvh.node_minima(&value);
-        PointField {
+        SourceField {
             bvh,
             value,
             node_min,
@@ -171,9 +269,10 @@ impl PointField {
             if n.is_leaf() {
                 let s = n.start as usize;
                 for slot in s..s + n.count as usize {
-                    let q = self.bvh.prim_corners[slot][0];
+                    let [a, b, c] = self.bvh.prim_corners[slot];
                     let i = self.bvh.prim_triangle[slot] as usize;
-                    best = best.min(self.value[i] + self.slope * norm(sub(p, q)));
+                    let d = closest_point_triangle(p, a, b, c).dist2.sqrt();
+                    best = best.min(self.value[i] + self.slope * d);
                 }
             } else if sp + 2 <= MAX_DEPTH {
                 let (l, r) = (ni + 1, n.start as usize);

@@ -251,11 +251,11 @@ fn run(
         },
     );
     // Only caps below the uniform length matter.
-    let cap: Vec<f64> = cap
+    let cap: Vec<field::Source> = cap
         .into_iter()
-        .map(|c| if l0.is_some_and(|l| c >= l) { f64::INFINITY } else { c })
+        .filter(|c| !l0.is_some_and(|l| c.1 >= l))
         .collect();
-    let cap = field::PointField::new(input.vertices(), &cap, params.gradation);
+    let cap = field::SourceField::new(&cap, params.gradation);
     let edge_is_feature: Vec<bool> = features.edge_flags.iter().map(|&f| f != 0).collect();
     {
         let no_lines = reference::FeatureLines::default();

@@ -4,7 +4,7 @@
 
 use crate::geometry::{closest_point_triangle, dist2, dot, norm, sub, ClosestPoint};
 use crate::mesh::halfedge::{HalfedgeMesh, E_FEATURE, NONE, V_CORNER, V_FEATURE};
-use super::field::PointField;
+use super::field::SourceField;
 use crate::mesh::Grid;
 use crate::spatial::{Bvh, ClosestHit, MAX_DEPTH};
 
@@ -212,7 +212,7 @@ pub struct Reference<'a> {
     /// Uniform target length (`None` in size-driven mode).
     pub base: Option<f64>,
     /// Cap on the target length (curvature and creases, graded).
-    pub cap: &'a PointField,
+    pub cap: &'a SourceField,
     /// Size-driven mode: the grid whose sizes give the target length.
     pub sizing: Option<&'a Grid>,
 }

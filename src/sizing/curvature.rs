@@ -151,8 +151,33 @@ fn solve3(m: &[[f64; 3]; 3], b: &[f64; 3], det: f64) -> [f64; 3] {
     out
 }
 
-/// Principal curvatures of every vertex. O(V · ring size), parallel.
+/// Principal curvatures of every vertex: the largest (by `max_abs`) over its
+/// patches. O(V · ring size), parallel.
 pub fn principal_curvatures(
+    grid: &Grid,
+    features: &Features,
+    normals: &PatchNormals,
+) -> Vec<Curvature> {
+    let per_patch = patch_curvatures(grid, features, normals);
+    (0..grid.vertices().len())
+        .into_par_iter()
+        .map(|vi| {
+            let mut best = Curvature::default();
+            for e in normals.range(vi) {
+                let c = per_patch[e];
+                if c.max_abs() > best.max_abs() || best.d1 == [0.0; 3] {
+                    best = c;
+                }
+            }
+            best
+        })
+        .collect()
+}
+
+/// Principal curvatures of every (vertex, patch) entry of `normals`, fitted
+/// to the vertex's neighbours within that patch (1-ring, 2-ring when the
+/// 1-ring has fewer than 4). O(V · ring size), parallel.
+pub fn patch_curvatures(
     grid: &Grid,
     features: &Features,
     normals: &PatchNormals,
@@ -160,13 +185,13 @@ pub fn principal_curvatures(
     let v = grid.vertices();
     let tris = grid.triangles();
     let topo = grid.topology();
-    (0..v.len())
+    (0..normals.patch.len())
         .into_par_iter()
-        .map(|vi| {
-            let mut best = Curvature::default();
-            let mut ring: Vec<u32> = Vec::new();
-            let mut pts: Vec<[f64; 3]> = Vec::new();
-            for e in normals.range(vi) {
+        .map_init(
+            || (Vec::<u32>::new(), Vec::<[f64; 3]>::new()),
+            |(ring, pts), e| {
+                // Vertex of entry e: the last offset not above e.
+                let vi = normals.offsets.partition_point(|&o| o as usize <= e) - 1;
                 let patch = normals.patch[e];
                 ring.clear();
                 let collect = |u: usize, ring: &mut Vec<u32>| {
@@ -180,22 +205,18 @@ pub fn principal_curvatures(
                         }
                     }
                 };
-                collect(vi, &mut ring);
+                collect(vi, ring);
                 if ring.len() < 4 {
                     let first: Vec<u32> = ring.clone();
                     for u in first {
-                        collect(u as usize, &mut ring);
+                        collect(u as usize, ring);
                     }
                 }
                 pts.clear();
                 pts.extend(ring.iter().map(|&w| v[w as usize]));
-                let c = fit(v[vi], normals.normal[e], &pts);
-                if c.max_abs() > best.max_abs() || best.d1 == [0.0; 3] {
-                    best = c;
-                }
-            }
-            best
-        })
+                fit(v[vi], normals.normal[e], pts)
+            },
+        )
         .collect()
 }
 
