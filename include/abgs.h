@@ -72,8 +72,8 @@ typedef enum {
   ABGS_ERR_INTERNAL = 99,
 } abgs_status;
 
-// Opaque handle to a background grid. Create with `abgs_grid_from_arrays` or
-// `abgs_grid_load`, release with `abgs_grid_free`.
+// Opaque handle to a background grid. Create with `abgs_grid_from_arrays`,
+// `abgs_grid_load` or `abgs_grid_remesh`, release with `abgs_grid_free`.
 typedef struct abgs_grid abgs_grid;
 
 // Counts, validation findings and extent of a grid.
@@ -129,6 +129,62 @@ typedef struct {
   // Interpolated size (NaN when the grid has no sizes).
   double size;
 } abgs_hit;
+
+// Parameters of `abgs_grid_remesh`; get the defaults from `abgs_remesh_params_default`.
+// Every field is checked in both modes: a NaN or infinite value gives
+// ABGS_ERR_NON_FINITE, a finite value out of range ABGS_ERR_INVALID_ARGUMENT.
+typedef struct {
+  // Uniform target edge length L0 in model units, >= 0; 0 = use
+  // `relative_length` (default 0). Ignored in size-driven mode.
+  double edge_length;
+  // Uniform target edge length as a fraction of the bounding-box diagonal,
+  // used when `edge_length` is 0; must then be > 0 (default 0.01: diagonal / 100).
+  // Ignored in size-driven mode.
+  double relative_length;
+  // Dihedral angle above which an edge is a feature kept as a line, degrees
+  // in [0, 180] (default 30).
+  double feature_angle_deg;
+  // Split / collapse / flip / relax iterations, >= 1 (default 10).
+  uint32_t iterations;
+  // 1 = cap the target length at half the curvature size
+  // `π / (κ · n_circle)`, so small fillets are resolved; 0 = off (default 1).
+  int32_t curvature_limit;
+  // Elements per full circle in that curvature size, in (0, 1e9] (default 24).
+  double n_circle;
+} abgs_remesh_params;
+
+// What `abgs_grid_remesh` did.
+typedef struct {
+  // Vertices of the input.
+  uint64_t vertices_in;
+  // Triangles of the input.
+  uint64_t faces_in;
+  // Vertices of the output.
+  uint64_t vertices_out;
+  // Triangles of the output.
+  uint64_t faces_out;
+  // Uniform target length L0 used (NaN in size-driven mode).
+  double target_length;
+  // Smallest target length over the output vertices (after the curvature cap).
+  double target_min;
+  // Largest target length over the output vertices.
+  double target_max;
+  // Feature edges of the input (dihedral angle, boundary, non-manifold).
+  uint64_t feature_edges_in;
+  // Feature edges kept in the output (see `abgs_grid_remesh_copy_feature_edges`).
+  uint64_t feature_edges_out;
+  // Feature lines: chains of feature edges between corners, or loops.
+  uint64_t feature_lines;
+  // Corners (fixed vertices), counting copies at non-manifold vertices.
+  uint64_t corners;
+  // Iterations done.
+  uint64_t iterations;
+  // Total seconds.
+  double seconds;
+  // Number of things that could not be remeshed (0 when everything was);
+  // their texts come from `abgs_grid_remesh_issue`.
+  uint64_t n_issues;
+} abgs_remesh_report;
 
 // A user size source: every vertex within `radius` of the shape gets at most `size`.
 typedef struct {
@@ -408,6 +464,84 @@ abgs_status abgs_query_closest(const abgs_grid *grid,
                                const double *point,
                                uint32_t hint,
                                abgs_hit *out_hit);
+
+// Writes the default parameters into `*out_params`.
+//
+// # Safety
+// `out_params` is NULL (reported) or writable.
+abgs_status abgs_remesh_params_default(abgs_remesh_params *out_params);
+
+// Remeshes `input` into a new grid of well-shaped triangles (isotropic
+// remeshing: split, collapse, flip, tangential relaxation with projection onto
+// the input). Feature lines (dihedral angle above `feature_angle_deg`,
+// boundaries, non-manifold edges) and their corners are kept, bodies stay apart,
+// and no boundary or non-manifold edge is added.
+//
+// Uniform mode when `sizing` is NULL (target length from `edge_length` or
+// `relative_length`); size-driven mode otherwise: the target length at a point
+// is the size `sizing` gives there (`abgs_query_size`), so `sizing` must carry
+// sizes (it may be `input` itself). In both modes the target is capped by
+// curvature when `curvature_limit` is 1. `params` NULL = the defaults.
+//
+// On success `*out_grid` owns a new grid without sizes (set them with
+// `abgs_grid_set_sizes` or `abgs_compute_size`), whose handle also holds the
+// kept feature edges and the texts of what could not be remeshed
+// (`abgs_grid_remesh_copy_feature_edges`, `abgs_grid_remesh_issue`); on
+// failure `*out_grid` is NULL. `out_report` (may be NULL) receives what was
+// done, on success only. Dirty input (slivers, open surfaces, touching bodies)
+// is not an error: what was left as it was is counted in `n_issues`.
+// `input` and `sizing` are only read (other const calls may run on them
+// meanwhile; a mutating call on them returns BUSY until this one returns).
+// Cost: O(F log F) per iteration, parallel on the rayon thread pool; the result
+// does not depend on the thread count.
+//
+// Errors: NULL (input, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
+// NO_SIZES (a sizing grid without sizes), BUSY (a mutation is running on
+// `input` or `sizing`), EMPTY (nothing left).
+//
+// # Safety
+// Pointers are NULL (reported, or meaning "absent" where documented) or valid;
+// grid pointers come from this library and are not freed.
+abgs_status abgs_grid_remesh(const abgs_grid *input,
+                             const abgs_grid *sizing,
+                             const abgs_remesh_params *params,
+                             abgs_grid **out_grid,
+                             abgs_remesh_report *out_report);
+
+// Number of feature edges the remesher kept into `*out_count` (the
+// constrained polylines along the input's feature lines, boundaries and
+// non-manifold edges). Errors: NULL, INVALID_ARGUMENT (the grid was not made
+// by `abgs_grid_remesh`).
+//
+// # Safety
+// Pointers are NULL (reported) or valid.
+abgs_status abgs_grid_remesh_feature_edge_count(const abgs_grid *grid, size_t *out_count);
+
+// Copies the kept feature edges, two vertex indices of the grid each, into
+// `out_edges` (`capacity` >= 2 × `abgs_grid_remesh_feature_edge_count`, else
+// BUFFER_TOO_SMALL). Errors: NULL, INVALID_ARGUMENT (not a remeshed grid).
+//
+// # Safety
+// Pointers are NULL (reported) or valid for `capacity` indices.
+abgs_status abgs_grid_remesh_copy_feature_edges(const abgs_grid *grid,
+                                                uint32_t *out_edges,
+                                                size_t capacity);
+
+// Copies the text of issue `index` (0-based, below `abgs_remesh_report.n_issues`)
+// of a remeshed grid, UTF-8 and NUL-terminated, into `out_text` (`capacity`
+// bytes). `*out_len` (may be NULL) receives the bytes needed, NUL included,
+// also when the buffer is too small; `out_text` may be NULL with `capacity` 0
+// to ask for that length only. Errors: NULL (grid), INVALID_ARGUMENT (not a
+// remeshed grid), OUT_OF_RANGE (index), BUFFER_TOO_SMALL.
+//
+// # Safety
+// Pointers are NULL (reported / ignored where documented) or valid;
+// `out_text` holds `capacity` writable bytes.
+abgs_status abgs_grid_remesh_issue(const abgs_grid *grid,
+                                   size_t index,
+                                   char *out_text,
+                                   size_t capacity,
+                                   size_t *out_len);
 
 // Writes the default parameters into `*out_params`.
 //

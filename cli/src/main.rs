@@ -1,10 +1,12 @@
 //! `abgs`: command-line front end of the abgs library.
 //!
-//! Subcommands: `info`, `convert`, `query`, `bench-query`. Run `abgs --help`.
+//! Subcommands: `info`, `convert`, `query`, `bench-query`, `size`,
+//! `check-gradation`, `grid`. Run `abgs --help`.
 
 #![allow(clippy::needless_range_loop)]
 
 mod bench;
+mod grid;
 mod info;
 mod points;
 mod progress;
@@ -91,6 +93,17 @@ enum Command {
         #[arg(long)]
         slope: Option<f64>,
     },
+    /// Remesh a surface into a dense grid of well-shaped triangles (isotropic remeshing,
+    /// feature lines and corners kept): uniform, or size-driven with --size-from.
+    Grid {
+        /// Input surface.
+        input: PathBuf,
+        /// Output file (vtk recommended).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        args: grid::GridArgs,
+    },
     /// Measure queries per second on three point sets (near-surface, uniform in the box,
     /// a coherent front-like walk) for plain, hinted and batch queries, 1 thread and all threads.
     BenchQuery {
@@ -127,6 +140,18 @@ fn main() -> ExitCode {
             json,
         } => bench::run(&grid, points, seconds, json),
         Command::Size { grid, output, args } => size::run(&grid, &output, &args),
+        Command::Grid {
+            input,
+            output,
+            args,
+        } => match grid::run(&input, &output, &args) {
+            Ok(true) => Ok(()),
+            Ok(false) => {
+                eprintln!("abgs: the remeshed grid failed a check");
+                return ExitCode::FAILURE;
+            }
+            Err(e) => Err(e),
+        },
         Command::CheckGradation { grid, beta, slope } => match size::check(&grid, beta, slope) {
             Ok(true) => Ok(()),
             Ok(false) => {

@@ -248,3 +248,205 @@ fn size_writes_all_arrays_and_check_gradation_passes() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("beta"));
 }
+
+/// A closed 1 × 2 × 0.5 box of 12 triangles, written as OBJ.
+fn box_obj(tag: &str) -> PathBuf {
+    let path = tmp(&format!("box-{tag}.obj"));
+    let v = (0..8)
+        .map(|i| {
+            [
+                (i & 1) as f64,
+                2.0 * ((i >> 1) & 1) as f64,
+                0.5 * ((i >> 2) & 1) as f64,
+            ]
+        })
+        .collect();
+    let t = vec![
+        [0, 3, 1],
+        [0, 2, 3],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
+    ];
+    abgs::Grid::from_arrays(v, t, None, &abgs::BuildOptions::default())
+        .unwrap()
+        .save(&path)
+        .unwrap();
+    path
+}
+
+#[test]
+fn grid_remeshes_uniformly_and_by_sizes_and_checks() {
+    let input = box_obj("grid");
+    let dense = tmp("box-dense.vtk");
+    let out = abgs()
+        .arg("grid")
+        .arg(&input)
+        .arg("-o")
+        .arg(&dense)
+        .args(["--relative", "0.05", "--check"])
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains("acceptance: pass"), "{stdout}");
+    assert!(stdout.contains("min-angle p1:"), "{stdout}");
+    assert!(
+        stdout.contains("bodies in / out:            1 / 1"),
+        "{stdout}"
+    );
+    assert!(stderr.contains("feature lines 12  corners 8"), "{stderr}");
+    assert!(stderr.contains("issues: none"), "{stderr}");
+    let g = abgs::Grid::load(&dense).unwrap();
+    assert!(g.triangles().len() > 500, "{}", g.triangles().len());
+    assert!(g.sizes().is_none());
+    // Every vertex lies on the box's surface.
+    let hi = [1.0, 2.0, 0.5];
+    for p in g.vertices() {
+        let inside = (0..3).all(|k| p[k] >= -1e-9 && p[k] <= hi[k] + 1e-9);
+        let on_face = (0..3).any(|k| p[k].abs() <= 1e-9 || (p[k] - hi[k]).abs() <= 1e-9);
+        assert!(inside && on_face, "{p:?}");
+    }
+
+    // Size-driven: sizes from `abgs size`, finer near a point source.
+    let sized = tmp("box-sized.vtk");
+    let st = abgs()
+        .arg("size")
+        .arg(&input)
+        .arg("-o")
+        .arg(&sized)
+        .args(["--source", "point 0 0 0 0.03 0.3"])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let dense2 = tmp("box-dense2.vtk");
+    let out = abgs()
+        .arg("grid")
+        .arg(&input)
+        .arg("-o")
+        .arg(&dense2)
+        .arg("--size-from")
+        .arg(&sized)
+        .arg("--check")
+        .output()
+        .unwrap();
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stderr.contains("size-driven from"), "{stderr}");
+    assert!(stdout.contains("acceptance: pass"), "{stdout}");
+    let ratio = stdout
+        .lines()
+        .find(|l| l.starts_with("edge length / h(midpoint)"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let mean: f64 = ratio
+        .split("mean ")
+        .nth(1)
+        .and_then(|s| s.split(',').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{ratio}"));
+    assert!((0.6..=1.5).contains(&mean), "{ratio}");
+    // Finer near the source corner than at the opposite one.
+    let g2 = abgs::Grid::load(&dense2).unwrap();
+    let near = |c: [f64; 3]| {
+        g2.vertices()
+            .iter()
+            .filter(|p| (0..3).map(|k| (p[k] - c[k]).powi(2)).sum::<f64>() < 0.09)
+            .count()
+    };
+    assert!(
+        near([0.0; 3]) > 3 * near([1.0, 2.0, 0.5]),
+        "{} vs {}",
+        near([0.0; 3]),
+        near([1.0, 2.0, 0.5])
+    );
+}
+
+#[test]
+fn grid_check_failures_and_bad_arguments_exit_1() {
+    // A coarse remesh of a cylinder (no curvature cap) is too far from it.
+    let n = 48;
+    let mut v = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 2.0]];
+    for i in 0..n {
+        let a = std::f64::consts::TAU * i as f64 / n as f64;
+        v.push([a.cos(), a.sin(), 0.0]);
+        v.push([a.cos(), a.sin(), 2.0]);
+    }
+    let (b, tp) = (
+        |i: usize| 2 + 2 * (i % n) as u32,
+        |i: usize| 3 + 2 * (i % n) as u32,
+    );
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push([b(i), b(i + 1), tp(i + 1)]);
+        t.push([b(i), tp(i + 1), tp(i)]);
+        t.push([0, b(i + 1), b(i)]);
+        t.push([1, tp(i), tp(i + 1)]);
+    }
+    let input = tmp("cylinder.obj");
+    abgs::Grid::from_arrays(v, t, None, &abgs::BuildOptions::default())
+        .unwrap()
+        .save(&input)
+        .unwrap();
+    let out_path = tmp("cylinder-dense.vtk");
+    let out = abgs()
+        .arg("grid")
+        .arg(&input)
+        .arg("-o")
+        .arg(&out_path)
+        .args(["--relative", "0.2", "--no-curvature-limit", "--check"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("acceptance: FAIL") && stdout.contains("Hausdorff"),
+        "{stdout}"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("failed a check"));
+
+    let fails = |args: &[&str], needle: &str| {
+        let out = abgs()
+            .arg("grid")
+            .arg(&input)
+            .arg("-o")
+            .arg(&out_path)
+            .args(args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+    };
+    fails(&["--iterations", "0"], "--iterations");
+    fails(&["--edge-length=-1"], "edge length");
+    fails(&["--relative", "NaN"], "edge length");
+    fails(&["--feature-angle", "200"], "feature_angle_deg");
+    fails(
+        &["--edge-length", "0.1", "--relative", "0.1"],
+        "cannot be used with",
+    );
+    // A sizing grid must carry sizes.
+    let plain = input.to_str().unwrap();
+    fails(&["--size-from", plain], "has no sizes");
+    fails(
+        &["--size-from", plain, "--relative", "0.1"],
+        "cannot be used with",
+    );
+}

@@ -1,14 +1,19 @@
 //! Grid lifecycle, I/O, sizes, statistics and copy-out accessors.
 
 use super::boundary::*;
+use super::remesh::RemeshInfo;
 use crate::mesh::{BuildOptions, Grid};
 use std::ffi::c_char;
 use std::sync::{RwLock, RwLockReadGuard, RwLockWriteGuard, TryLockError};
 
-/// Opaque handle to a background grid. Create with `abgs_grid_from_arrays` or
-/// `abgs_grid_load`, release with `abgs_grid_free`.
+/// Opaque handle to a background grid. Create with `abgs_grid_from_arrays`,
+/// `abgs_grid_load` or `abgs_grid_remesh`, release with `abgs_grid_free`.
 pub struct abgs_grid {
     lock: RwLock<Grid>,
+    /// What `abgs_grid_remesh` kept (feature edges) and reported (issues);
+    /// `None` for grids made otherwise. Never changes after creation (no call
+    /// changes a grid's vertices or triangles); read it under [`abgs_grid::read`].
+    remeshed: Option<RemeshInfo>,
 }
 
 impl abgs_grid {
@@ -43,9 +48,20 @@ impl abgs_grid {
     }
 
     fn boxed(g: Grid) -> *mut abgs_grid {
+        Self::boxed_with(g, None)
+    }
+
+    /// A new handle owning `g` and, for a remeshed grid, what the remesher kept.
+    pub(crate) fn boxed_with(g: Grid, remeshed: Option<RemeshInfo>) -> *mut abgs_grid {
         Box::into_raw(Box::new(abgs_grid {
             lock: RwLock::new(g),
+            remeshed,
         }))
+    }
+
+    /// The remesher's record, if this grid came from `abgs_grid_remesh`.
+    pub(crate) fn remeshed(&self) -> Option<&RemeshInfo> {
+        self.remeshed.as_ref()
     }
 }
 

@@ -16,9 +16,11 @@
 mod boundary;
 mod grid;
 mod query;
+mod remesh;
 mod sizing;
 
 pub use boundary::*;
 pub use grid::*;
 pub use query::*;
+pub use remesh::*;
 pub use sizing::*;
