@@ -34,13 +34,19 @@ fn main() {
     if let Some(r) = std::env::var("MIN_RATIO").ok().and_then(|s| s.parse().ok()) {
         params.min_length_ratio = r;
     }
-    if let Some(r) = std::env::var("LINE_MIN_RATIO").ok().and_then(|s| s.parse().ok()) {
+    if let Some(r) = std::env::var("LINE_MIN_RATIO")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
         params.line_min_length_ratio = r;
     }
     if let Some(r) = std::env::var("GRADATION").ok().and_then(|s| s.parse().ok()) {
         params.gradation = r;
     }
-    if let Some(r) = std::env::var("ITERATIONS").ok().and_then(|s| s.parse().ok()) {
+    if let Some(r) = std::env::var("ITERATIONS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
         params.iterations = r;
     }
     println!(
@@ -48,7 +54,11 @@ fn main() {
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for p in files {
-        let name = p.file_name().unwrap_or_default().to_string_lossy().to_string();
+        let name = p
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
         let input = match Grid::load(&p) {
             Ok(g) => g,
             Err(e) => {

@@ -51,10 +51,7 @@ fn box_is_remeshed_with_sharp_edges_and_corners_kept() {
             2.0 * ((i >> 1) & 1) as f64,
             0.5 * ((i >> 2) & 1) as f64,
         ];
-        assert!(
-            out.grid.vertices().contains(&c),
-            "corner {c:?} lost"
-        );
+        assert!(out.grid.vertices().contains(&c), "corner {c:?} lost");
     }
     // Iterations converge: the last one changes little.
     let last = out.report.iterations.last().unwrap();
@@ -71,24 +68,112 @@ fn cylinder_keeps_its_rims() {
 }
 
 #[test]
-fn touching_boxes_stay_apart_and_the_contact_is_kept() {
+fn needle_tessellated_cylinder_is_refined_along_its_whole_length() {
+    // A CAD export tessellates a long fillet by needles spanning its length
+    // (here 16 facets around, one along 40 radii): the curvature cap must
+    // reach the middle of the needles, not only their ends.
+    let g = cylinder(1.0, 40.0, 16, 1, 1);
+    let p = params(0.01);
+    let l0 = 0.01 * g.bbox().diagonal();
+    let out = remesh(&g, &p).unwrap();
+    accept("needle cylinder", &g, &out, true);
+    let v = out.grid.vertices();
+    let topo = out.grid.topology();
+    let (mut sum, mut n) = (0.0, 0usize);
+    for e in &topo.edges {
+        let [a, b] = e.map(|i| v[i as usize]);
+        if (15.0..25.0).contains(&(0.5 * (a[2] + b[2]))) {
+            sum += (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
+            n += 1;
+        }
+    }
+    // Half the curvature size is π/24 ≈ 0.13 < L0 ≈ 0.40.
+    let mean = sum / n as f64;
+    let cap = 0.5 * 2.0 * std::f64::consts::PI / 24.0;
+    assert!(
+        mean < 1.3 * cap && mean < 0.5 * l0,
+        "mean {mean}, cap {cap}, L0 {l0}"
+    );
+}
+
+#[test]
+fn boxes_sharing_an_edge_stay_apart_and_the_edge_is_kept() {
+    // Two unit boxes touching along the line x = 1, y = 1: four faces meet
+    // at each of its edges (non-manifold), one body each side.
+    let mut s = Soup::default();
+    s.boxed([0.0; 3], [1.0, 1.0, 1.0], 3, false, false);
+    s.boxed([1.0, 1.0, 0.0], [2.0, 2.0, 1.0], 3, false, false);
+    let g = s.grid();
+    assert_eq!(g.topology().body_count, 2);
+    assert!(g.report().non_manifold_edges > 0, "{:?}", g.report());
+    let out = remesh(&g, &params(0.03)).unwrap();
+    accept("boxes sharing an edge", &g, &out, true);
+    // The contact line may be refined (both sides alike) but stays whole:
+    // its non-manifold edges add up to its length, 1.
+    let nm_length = |g: &Grid| {
+        let topo = g.topology();
+        let v = g.vertices();
+        (0..topo.edges.len())
+            .filter(|&e| topo.faces_of_edge(e).len() > 2)
+            .map(|e| {
+                let [a, b] = topo.edges[e].map(|i| v[i as usize]);
+                (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
+            })
+            .sum::<f64>()
+    };
+    assert!((nm_length(&g) - 1.0).abs() < 1e-12);
+    assert!(
+        (nm_length(&out.grid) - 1.0).abs() < 1e-9,
+        "{}",
+        nm_length(&out.grid)
+    );
+    assert_eq!(out.grid.topology().body_count, 2);
+}
+
+#[test]
+fn box_standing_on_a_box_stays_two_bodies() {
+    // An assembly: a small box on a large one, the contact faces tessellated
+    // independently (no shared vertices), as CAD exports them.
+    let mut s = Soup::default();
+    s.boxed([0.0; 3], [2.0, 2.0, 1.0], 4, false, false);
+    s.boxed([0.3, 0.35, 1.0], [1.3, 1.35, 1.7], 3, false, false);
+    let g = s.grid();
+    assert_eq!(g.topology().body_count, 2);
+    let out = remesh(&g, &params(0.02)).unwrap();
+    accept("stacked boxes", &g, &out, true);
+    // Nothing of one body moved onto the other: the small box's bottom is
+    // still at z = 1 and inside its own footprint.
+    let v = out.grid.vertices();
+    let topo = out.grid.topology();
+    for (f, t) in out.grid.triangles().iter().enumerate() {
+        let c = t.map(|i| v[i as usize]);
+        if topo.face_body[f] != topo.face_body[0] {
+            assert!(c
+                .iter()
+                .all(|p| p[2] >= 1.0 - 1e-12 && p[0] >= 0.3 - 1e-12 && p[0] <= 1.3 + 1e-12));
+        }
+    }
+}
+
+#[test]
+fn coincident_contact_faces_do_not_break_the_remesher() {
+    // Two boxes whose contact faces are the same triangles (a conforming
+    // export): every contact triangle is on non-manifold edges only. The
+    // remesher must leave them as they are, say so, and keep the rest sound.
     let mut s = Soup::default();
     s.boxed([0.0; 3], [1.0, 1.0, 1.0], 4, false, false);
     s.boxed([1.0, 0.25, 0.25], [2.0, 0.75, 0.75], 2, false, false);
     let g = s.grid();
     assert!(g.report().non_manifold_edges > 0, "{:?}", g.report());
     let out = remesh(&g, &params(0.03)).unwrap();
-    accept("touching boxes", &g, &out, false);
-    assert_eq!(
-        out.grid.topology().non_manifold_edge_count(),
-        g.topology().non_manifold_edge_count()
-    );
-    assert!(out.report.build.split_vertices > 0);
     assert!(
         out.report.issues.iter().any(|s| s.contains("locked")),
         "{:?}",
         out.report.issues
     );
+    let a = quality::evaluate(&g, &out.grid, Some(&out.feature_edges), 30.0, 20_000);
+    assert!(a.hausdorff <= 1e-3 && a.min_angle_p1 >= 25.0, "{a:?}");
+    assert_eq!(a.new_boundary_edges, 0, "{a:?}");
 }
 
 #[test]
@@ -115,11 +200,29 @@ fn sliver_fans_are_cleaned_up() {
         }
     };
     quad_fan(&mut s, [0.0; 3], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], 200);
-    quad_fan(&mut s, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 200);
+    quad_fan(
+        &mut s,
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        200,
+    );
     quad_fan(&mut s, [0.0; 3], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], 200);
-    quad_fan(&mut s, [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], 200);
+    quad_fan(
+        &mut s,
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        200,
+    );
     quad_fan(&mut s, [0.0; 3], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0], 200);
-    quad_fan(&mut s, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 200);
+    quad_fan(
+        &mut s,
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        200,
+    );
     let g = s.grid();
     assert!(g.angle_stats().min_angle < 0.5);
     let out = remesh(&g, &params(0.03)).unwrap();

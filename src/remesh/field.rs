@@ -89,7 +89,10 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Sour
             .iter()
             .map(|&i| entry(i as usize, patch).map_or(0.0, |e| per_patch[e].max_abs()))
             .fold(f64::INFINITY, f64::min);
-        let floor_f = t.iter().map(|&i| floor(i as usize)).fold(f64::INFINITY, f64::min);
+        let floor_f = t
+            .iter()
+            .map(|&i| floor(i as usize))
+            .fold(f64::INFINITY, f64::min);
         let c = from_kappa(k, floor_f);
         if c.is_finite() {
             out.push((t.map(|i| v[i as usize]), c));
@@ -107,7 +110,11 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Sour
         let mut base = vec![f64::INFINITY; np];
         for (f, t) in tris.iter().enumerate() {
             let p = features.face_patch[f] as usize;
-            area[p] += crate::geometry::triangle_area(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
+            area[p] += crate::geometry::triangle_area(
+                v[t[0] as usize],
+                v[t[1] as usize],
+                v[t[2] as usize],
+            );
             for &i in t {
                 base[p] = base[p].min(s.base[i as usize]);
             }
@@ -134,7 +141,10 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Sour
             let fs = topo.faces_of_edge(e);
             for &a in fs {
                 for &b in fs {
-                    let (pa, pb) = (features.face_patch[a as usize] as usize, features.face_patch[b as usize] as usize);
+                    let (pa, pb) = (
+                        features.face_patch[a as usize] as usize,
+                        features.face_patch[b as usize] as usize,
+                    );
                     if pa != pb && STRIP_RATIO * width(pb) < floor_p(pb) {
                         beside_foil[pa] = true;
                     }
@@ -276,8 +286,10 @@ impl SourceField {
                 }
             } else if sp + 2 <= MAX_DEPTH {
                 let (l, r) = (ni + 1, n.start as usize);
-                let dl = self.node_min[l] + self.slope * self.bvh.nodes[l].bbox.distance2(&p).sqrt();
-                let dr = self.node_min[r] + self.slope * self.bvh.nodes[r].bbox.distance2(&p).sqrt();
+                let dl =
+                    self.node_min[l] + self.slope * self.bvh.nodes[l].bbox.distance2(&p).sqrt();
+                let dr =
+                    self.node_min[r] + self.slope * self.bvh.nodes[r].bbox.distance2(&p).sqrt();
                 // Visit the more promising child first.
                 let (first, second) = if dl <= dr { (l, r) } else { (r, l) };
                 stack[sp] = second as u32;

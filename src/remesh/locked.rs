@@ -13,7 +13,11 @@ use std::collections::BTreeMap;
 /// pieces; new vertices are locked corners with origins numbered from
 /// `next_origin` up, shared by the copies of one input edge. Returns the
 /// number of new pieces.
-pub fn presplit(mesh: &mut HalfedgeMesh, target: impl Fn([f64; 3]) -> f64, next_origin: u32) -> usize {
+pub fn presplit(
+    mesh: &mut HalfedgeMesh,
+    target: impl Fn([f64; 3]) -> f64,
+    next_origin: u32,
+) -> usize {
     // Copies of one input edge share the origins of their ends.
     let mut groups: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
     for e in 0..mesh.n_edges() as u32 {
@@ -21,7 +25,10 @@ pub fn presplit(mesh: &mut HalfedgeMesh, target: impl Fn([f64; 3]) -> f64, next_
             continue;
         }
         let [a, b] = mesh.edge_vertices(e);
-        let (oa, ob) = (mesh.vertex_origin[a as usize], mesh.vertex_origin[b as usize]);
+        let (oa, ob) = (
+            mesh.vertex_origin[a as usize],
+            mesh.vertex_origin[b as usize],
+        );
         if oa == NONE || ob == NONE {
             continue;
         }

@@ -30,7 +30,7 @@ pub mod reference;
 mod smooth;
 
 use crate::error::{Error, Result};
-use crate::mesh::halfedge::{BuildReport, HalfedgeMesh, E_LOCKED, NONE, V_CORNER, V_FEATURE};
+use crate::mesh::halfedge::{BuildReport, HalfedgeMesh, E_LOCKED, V_CORNER, V_FEATURE};
 use crate::mesh::{BuildOptions, Features, Grid};
 use ops::Limits;
 use reference::Reference;
@@ -59,8 +59,10 @@ pub struct RemeshParams {
     pub iterations: usize,
     /// Relaxation steps per iteration, each followed by projection (2).
     pub relax_steps: usize,
-    /// Cap the target locally at half the curvature size, `π / (κ · n_circle)`
-    /// (true), so small fillets are resolved.
+    /// Cap the uniform target locally at half the curvature size,
+    /// `π / (κ · n_circle)`, and at the width of narrow strips and creases
+    /// (true), so small fillets are resolved. Not used by [`remesh_sized`],
+    /// whose target is the size field itself.
     pub curvature_limit: bool,
     /// Elements per full circle in the curvature size (24).
     pub n_circle: f64,
@@ -188,11 +190,14 @@ pub fn remesh(input: &Grid, params: &RemeshParams) -> Result<Remeshed> {
 }
 
 /// Size-driven remeshing: the target length at a point is the size `sizing`
-/// gives there ([`Grid::query_size`]), capped by curvature when
-/// `params.curvature_limit`. `sizing` must carry sizes (it may be `input`).
+/// gives there (its surface query), with no other cap: the result has the
+/// elements a mesher following that field would make. `sizing` must carry
+/// sizes (it may be `input`).
 pub fn remesh_sized(input: &Grid, sizing: &Grid, params: &RemeshParams) -> Result<Remeshed> {
     if sizing.sizes().is_none() {
-        return Err(Error::InvalidArgument("the sizing grid has no sizes".into()));
+        return Err(Error::InvalidArgument(
+            "the sizing grid has no sizes".into(),
+        ));
     }
     run(input, Some(sizing), None, params)
 }
@@ -211,9 +216,19 @@ fn check(params: &RemeshParams) -> Result<()> {
     within(params.corner_angle_deg, 0.0, 180.0, "corner_angle_deg")?;
     within(params.n_circle, 1e-9, 1e9, "n_circle")?;
     within(params.min_length_ratio, 0.0, 1.0, "min_length_ratio")?;
-    within(params.line_min_length_ratio, 0.0, 1.0, "line_min_length_ratio")?;
+    within(
+        params.line_min_length_ratio,
+        0.0,
+        1.0,
+        "line_min_length_ratio",
+    )?;
     within(params.gradation, 0.0, 1e9, "gradation")?;
-    within(params.max_normal_turn_deg, 0.0, 180.0, "max_normal_turn_deg")?;
+    within(
+        params.max_normal_turn_deg,
+        0.0,
+        180.0,
+        "max_normal_turn_deg",
+    )?;
     within(params.sliver_angle_deg, 0.0, 60.0, "sliver_angle_deg")?;
     within(params.fidelity, 0.0, 1e9, "fidelity")
 }
@@ -243,7 +258,8 @@ fn run(
         &field::CapSettings {
             base,
             crease_tolerance: params.fidelity,
-            curvature: params.curvature_limit,
+            // Size-driven: L = h exactly (h carries its own curvature term).
+            curvature: params.curvature_limit && l0.is_some(),
             n_circle: params.n_circle,
             min_ratio: params.min_length_ratio,
             line_min_ratio: params.line_min_length_ratio,
@@ -269,7 +285,11 @@ fn run(
             cap: &cap,
             sizing,
         };
-        locked::presplit(&mut mesh, |p| sizes.target(p), input.vertices().len() as u32);
+        locked::presplit(
+            &mut mesh,
+            |p| sizes.target(p),
+            input.vertices().len() as u32,
+        );
     }
     let (lines, _) = reference::feature_lines(&mut mesh, params.corner_angle_deg);
     let mut reference = Reference {
@@ -311,57 +331,12 @@ fn run(
         build,
         ..Default::default()
     };
-    let dbg = std::env::var_os("REMESH_DEBUG").is_some();
-    let t_setup = start.elapsed();
-    if dbg {
-        eprintln!("setup {t_setup:?}");
-    }
-    if dbg {
-        let s: Vec<f64> = mesh.vertex_size.clone();
-        eprintln!("l0 {l0:?} sizes min {} max {}", s.iter().cloned().fold(f64::INFINITY, f64::min), s.iter().cloned().fold(0.0, f64::max));
-    }
-    let zero = |mesh: &HalfedgeMesh| {
-        let n = mesh.faces()
-            .filter(|&f| {
-                let [a, b, c] = mesh.face_vertices(f).map(|v| mesh.positions[v as usize]);
-                ops::flatness(a, b, c) <= 1e-4
-            })
-            .count();
-        let locked: Vec<[[f64; 3]; 2]> = mesh.edges().filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED != 0).map(|e| mesh.edge_vertices(e).map(|v| mesh.positions[v as usize])).collect();
-        let on: Vec<u32> = mesh.vertices().filter(|&v| mesh.vertex_flags[v as usize] == 0 && locked.iter().any(|s| {
-            let p = mesh.positions[v as usize];
-            let t = crate::geometry::closest_point_on_segment(p, s[0], s[1]);
-            crate::geometry::dist2(p, crate::geometry::lerp(s[0], s[1], t)) < 1e-18
-        })).collect();
-        let pp: u32 = std::env::var("PATCH").ok().and_then(|x| x.parse().ok()).unwrap_or(u32::MAX);
-        let rims: Vec<[[f64; 3]; 2]> = mesh.edges().filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED != 0 && [2*e, 2*e+1].iter().any(|&h| { let f = mesh.face(h); f != NONE && mesh.face_patch[f as usize] == pp })).map(|e| mesh.edge_vertices(e).map(|v| mesh.positions[v as usize])).collect();
-        let mut onrim = 0;
-        let mut nfp = 0;
-        for f in mesh.faces() {
-            if mesh.face_patch[f as usize] != pp { continue; }
-            nfp += 1;
-            for v in mesh.face_vertices(f) {
-                if mesh.vertex_flags[v as usize] == 0 {
-                    let p = mesh.positions[v as usize];
-                    if rims.iter().any(|s| { let t = crate::geometry::closest_point_on_segment(p, s[0], s[1]); crate::geometry::dist2(p, crate::geometry::lerp(s[0], s[1], t)) < 1e-6 }) { onrim += 1; }
-                }
-            }
-        }
-        format!("{n} free-on-locked {} patch faces {nfp} on-rim {onrim}", on.len())
-    };
-    if dbg {
-        eprintln!("zero at start {}", zero(&mesh));
-    }
     for _ in 0..params.iterations {
         let t = Instant::now();
         let splits = ops::split_long(&mut mesh, &reference, &lim);
-        if dbg { eprintln!("splits {splits} {:?} zero {}", t.elapsed(), zero(&mesh)); mesh.check().unwrap(); }
         let collapses = ops::collapse_short(&mut mesh, &lim);
-        if dbg { eprintln!("collapses {collapses} {:?} zero {}", t.elapsed(), zero(&mesh)); mesh.check().unwrap(); }
         let repaired = ops::repair_flat(&mut mesh, &lim, 0.02);
-        if dbg { eprintln!("repaired {repaired} zero {}", zero(&mesh)); }
         let flips = ops::flip_valence(&mut mesh, &lim);
-        if dbg { eprintln!("flips {flips} {:?} zero {}", t.elapsed(), zero(&mesh)); mesh.check().unwrap(); }
         let mut it = IterationReport {
             splits,
             collapses: collapses + repaired,
@@ -373,9 +348,6 @@ fn run(
             it.cut_moves += smooth::relax_and_project(&mut mesh, &reference, relax, lim.cos_turn);
         }
         mesh.compact();
-        if dbg {
-            eprintln!("relax zero {}", zero(&mesh));
-        }
         it.vertices = mesh.vertex_count();
         it.faces = mesh.face_count();
         it.seconds = t.elapsed().as_secs_f64();
@@ -386,66 +358,10 @@ fn run(
     smooth::relax_and_project(&mut mesh, &reference, false, lim.cos_turn);
     mesh.compact();
 
-    if dbg {
-        let mut n = 0;
-        for f in mesh.faces() {
-            let vs = mesh.face_vertices(f);
-            let [a, b, c] = vs.map(|v| mesh.positions[v as usize]);
-            let (ab, ac, bc) = (crate::geometry::sub(b, a), crate::geometry::sub(c, a), crate::geometry::sub(c, b));
-            let l2 = crate::geometry::norm2(ab).max(crate::geometry::norm2(ac)).max(crate::geometry::norm2(bc));
-            if crate::geometry::norm(crate::geometry::cross(ab, ac)) <= 1e-4 * l2 {
-                n += 1;
-                if n % 1000 == 1 {
-                    let fl = vs.map(|v| mesh.vertex_flags[v as usize]);
-                    let hs = mesh.face_halfedges(f).map(|h| mesh.edge_flags[mesh.edge(h) as usize]);
-                    eprintln!("zero face {f} {vs:?} flags {fl:?} edges {hs:?} pos {:?} {:?} {:?} l2 {l2:e} patch {} sizes {:?}", a, b, c, mesh.face_patch[f as usize], vs.map(|v| mesh.vertex_size[v as usize]));
-                }
-            }
-        }
-        eprintln!("{n} zero faces");
-        let mut kinds = std::collections::BTreeMap::new();
-        for f in mesh.faces() {
-            let hs = mesh.face_halfedges(f);
-            let vs = mesh.face_vertices(f);
-            let [a, b, c] = vs.map(|v| mesh.positions[v as usize]);
-            if ops::flatness(a, b, c) > 1e-4 { continue; }
-            // longest edge
-            let lens: Vec<(f64, u32)> = hs.iter().map(|&h| (mesh.edge_length(mesh.edge(h)), h)).collect();
-            let (lmax, hmax) = lens.iter().cloned().fold((0.0, 0), |x, y| if y.0 > x.0 { y } else { x });
-            let lmin = lens.iter().map(|x| x.0).fold(f64::INFINITY, f64::min);
-            let needle = lmin < 0.1 * lmax;
-            let ef = mesh.edge_flags[mesh.edge(hmax) as usize];
-            let apex = mesh.to_vertex(mesh.next(hmax));
-            let key = format!("{} long-edge-flags {} apex-flags {} flat-neighbour {}", if needle {"needle"} else {"cap"}, ef, mesh.vertex_flags[apex as usize], {
-                let o = mesh.face(hmax ^ 1);
-                if o == NONE { "none".to_string() } else { let [x,y,z] = mesh.face_vertices(o).map(|v| mesh.positions[v as usize]); (ops::flatness(x,y,z) < 1e-4).to_string() }
-            });
-            *kinds.entry(key).or_insert(0) += 1;
-        }
-        for (k, n) in kinds { eprintln!("  {n:6} {k}"); }
-        if let Ok(pp) = std::env::var("PATCH") {
-            let pp: u32 = pp.parse().unwrap();
-            for (f, t) in input.triangles().iter().enumerate() {
-                if features.face_patch[f] == pp {
-                    eprintln!("input f{f} {:?} edges {:?}", t.map(|v| input.vertices()[v as usize]), input.topology().face_edges[f].map(|e| features.edge_flags[e as usize]));
-                }
-            }
-            let mut bb = crate::geometry::Aabb::EMPTY;
-            let mut nf = 0;
-            let mut nflat = 0;
-            for f in mesh.faces() {
-                if mesh.face_patch[f as usize] == pp {
-                    nf += 1;
-                    let vs = mesh.face_vertices(f);
-                    let [a, b, c] = vs.map(|v| mesh.positions[v as usize]);
-                    if ops::flatness(a, b, c) < 1e-4 { nflat += 1; if nflat < 6 { eprintln!("  flat {:?} flags {:?}", [a,b,c], vs.map(|v| mesh.vertex_flags[v as usize])); } }
-                    for p in [a, b, c] { bb.grow(&p); }
-                }
-            }
-            eprintln!("output patch {pp}: {nf} faces ({nflat} flat), bbox {bb:?}");
-        }
-    }
-    let sizes: Vec<f64> = mesh.vertices().map(|v| mesh.vertex_size[v as usize]).collect();
+    let sizes: Vec<f64> = mesh
+        .vertices()
+        .map(|v| mesh.vertex_size[v as usize])
+        .collect();
     report.target_range = [
         sizes.iter().copied().fold(f64::INFINITY, f64::min),
         sizes.iter().copied().fold(0.0, f64::max),

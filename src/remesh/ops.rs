@@ -10,8 +10,6 @@ use crate::mesh::halfedge::{
     HalfedgeMesh, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED,
 };
 
-static DBG_COUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-
 /// Geometric limits of the passes.
 #[derive(Debug, Clone, Copy)]
 pub struct Limits {
@@ -40,7 +38,10 @@ pub fn min_angle_deg(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
         let (u, v) = (sub(q, p), sub(r, p));
         norm(cross(u, v)).atan2(dot(u, v))
     };
-    ang(a, b, c).min(ang(b, c, a)).min(ang(c, a, b)).to_degrees()
+    ang(a, b, c)
+        .min(ang(b, c, a))
+        .min(ang(c, a, b))
+        .to_degrees()
 }
 
 fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
@@ -141,44 +142,7 @@ pub fn split_long(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) 
             } else {
                 NONE
             };
-            let dbg = std::env::var_os("REMESH_DEBUG").is_some();
-            let fl = |mesh: &HalfedgeMesh| {
-                mesh.vertex_faces(v)
-                    .map(|f| {
-                        let [x, y, z] = mesh.face_vertices(f).map(|q| mesh.positions[q as usize]);
-                        flatness(x, y, z)
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let q0 = if dbg { fl(mesh) } else { 0.0 };
-            let p0 = mesh.positions[v as usize];
             place_new_vertex(mesh, reference, v, lim.cos_turn);
-            if dbg {
-                let pp: u32 = std::env::var("PATCH").ok().and_then(|x| x.parse().ok()).unwrap_or(u32::MAX);
-                if mesh.vertex_faces(v).any(|f| mesh.face_patch[f as usize] == pp) {
-                    let pv = mesh.positions[v as usize];
-                    let on = mesh.vertex_faces(v).flat_map(|f| mesh.face_halfedges(f)).any(|h| {
-                        let e2 = mesh.edge(h);
-                        if mesh.edge_flags[e2 as usize] & E_LOCKED == 0 { return false; }
-                        let [x, y] = mesh.edge_vertices(e2).map(|q| mesh.positions[q as usize]);
-                        let t = crate::geometry::closest_point_on_segment(pv, x, y);
-                        crate::geometry::dist2(pv, lerp(x, y, t)) < 1e-18
-                    });
-                    let rim_any = mesh.edges().filter(|&e2| mesh.edge_flags[e2 as usize] & E_LOCKED != 0).any(|e2| {
-                        let [x, y] = mesh.edge_vertices(e2).map(|q| mesh.positions[q as usize]);
-                        let t = crate::geometry::closest_point_on_segment(pv, x, y);
-                        crate::geometry::dist2(pv, lerp(x, y, t)) < 1e-18
-                    });
-                    if (on || rim_any) && DBG_COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed) < 5 {
-                        eprintln!("PATCH split e{e} [{a} {b}] flags {:?} pa {pa:?} pb {pb:?} mid {p0:?} -> {pv:?} on-own-rim {on}; faces {:?}", [mesh.vertex_flags[a as usize], mesh.vertex_flags[b as usize]], mesh.vertex_faces(v).map(|f| (mesh.face_patch[f as usize], mesh.face_vertices(f))).collect::<Vec<_>>());
-                    }
-                }
-                let q1 = fl(mesh);
-                if q1 < 1e-4 && q0 >= 1e-4 && DBG_COUNT.load(std::sync::atomic::Ordering::Relaxed) > 100000 {
-                    let parent: Vec<_> = mesh.vertex_faces(v).map(|f| mesh.face_vertices(f).map(|q| (q, mesh.vertex_flags[q as usize]))).collect();
-                    eprintln!("flat after split e{e} [{a} {b}] flags {:?} len {} target {}: q before place {q0:.2e} after {q1:.2e}; moved {:?} -> {:?}; faces {parent:?}", [fa, fb], norm(sub(pa, pb)), target(mesh, a, b), p0, mesh.positions[v as usize]);
-                }
-            }
             count += 1;
         }
     }
@@ -248,17 +212,20 @@ pub fn collapse_ok(mesh: &HalfedgeMesh, h: u32, lim: &Limits) -> bool {
         if fvs.contains(&w) {
             continue;
         }
-        let np = fvs.map(|x| if x == v { pw } else { mesh.positions[x as usize] });
+        let np = fvs.map(|x| {
+            if x == v {
+                pw
+            } else {
+                mesh.positions[x as usize]
+            }
+        });
         let n_new = cross(sub(np[1], np[0]), sub(np[2], np[0]));
         let Some(n_new) = unit(n_new) else {
             return false;
         };
         let patch = mesh.face_patch[f as usize];
-        let reference = reliable_normal(a, b, c).or_else(|| {
-            star.iter()
-                .find(|x| x.0 == patch)
-                .and_then(|x| unit(x.1))
-        });
+        let reference = reliable_normal(a, b, c)
+            .or_else(|| star.iter().find(|x| x.0 == patch).and_then(|x| unit(x.1)));
         if let Some(n_old) = reference {
             if dot(n_new, n_old) < lim.cos_turn {
                 return false;

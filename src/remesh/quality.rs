@@ -67,7 +67,11 @@ impl Segments {
     /// About `n` points spread evenly by length, ends included.
     fn samples(&self, n: usize) -> Vec<[f64; 3]> {
         let total: f64 = self.segs.iter().map(|s| dist2(s[0], s[1]).sqrt()).sum();
-        let step = if total > 0.0 { total / n.max(1) as f64 } else { 1.0 };
+        let step = if total > 0.0 {
+            total / n.max(1) as f64
+        } else {
+            1.0
+        };
         let mut out = Vec::new();
         for s in &self.segs {
             let k = (dist2(s[0], s[1]).sqrt() / step).ceil().max(1.0) as usize;
@@ -115,7 +119,10 @@ fn two_way(a: &Segments, b: &Segments, n: usize) -> f64 {
 /// grid's BVH. O((n + V) log F).
 pub fn hausdorff(a: &Grid, b: &Grid, n: usize, seed: u64) -> f64 {
     let one = |x: &Grid, y: &Grid| {
-        let mut pts: Vec<[f64; 3]> = surface_points(x, n, seed).into_iter().map(|s| s.1).collect();
+        let mut pts: Vec<[f64; 3]> = surface_points(x, n, seed)
+            .into_iter()
+            .map(|s| s.1)
+            .collect();
         pts.extend_from_slice(x.vertices());
         pts.par_chunks(512)
             .map(|c| {
@@ -202,6 +209,8 @@ impl Acceptance {
     /// The acceptance thresholds: min-angle p1 ≥ 25°, max-angle p99 ≤ 110°,
     /// both Hausdorff distances ≤ 0.1 % of the diagonal, same bodies, no new
     /// boundary or non-manifold edges. Returns the failures (empty = pass).
+    /// A NaN measure fails.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn failures(&self) -> Vec<String> {
         let mut f = Vec::new();
         if !(self.min_angle_p1 >= 25.0) {
@@ -211,7 +220,10 @@ impl Acceptance {
             f.push(format!("max-angle p99 {:.1}° > 110°", self.max_angle_p99));
         }
         if !(self.hausdorff <= 1e-3) {
-            f.push(format!("Hausdorff {:.2e} > 1e-3 of the diagonal", self.hausdorff));
+            f.push(format!(
+                "Hausdorff {:.2e} > 1e-3 of the diagonal",
+                self.hausdorff
+            ));
         }
         if !(self.feature_hausdorff <= 1e-3) {
             f.push(format!(

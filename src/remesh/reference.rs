@@ -2,9 +2,9 @@
 //! triangles restricted to one smooth patch, the input feature segments
 //! restricted to one feature line, and the target edge length carried along.
 
+use super::field::SourceField;
 use crate::geometry::{closest_point_triangle, dist2, dot, norm, sub, ClosestPoint};
 use crate::mesh::halfedge::{HalfedgeMesh, E_FEATURE, NONE, V_CORNER, V_FEATURE};
-use super::field::SourceField;
 use crate::mesh::Grid;
 use crate::spatial::{Bvh, ClosestHit, MAX_DEPTH};
 

@@ -18,6 +18,9 @@ use crate::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::halfedge::{HalfedgeMesh, E_FEATURE, NONE, V_CORNER, V_FEATURE, V_LOCKED};
 use rayon::prelude::*;
 
+/// A projection onto the vertex's own part of the reference.
+type ProjectFn<'a> = dyn Fn([f64; 3]) -> Option<Projected> + 'a;
+
 /// Unit normals of the faces (zero for removed faces and for those whose
 /// normal is not trustworthy, see [`reliable_normal`]).
 fn face_normals(mesh: &HalfedgeMesh) -> Vec<[f64; 3]> {
@@ -42,14 +45,22 @@ fn move_ok(mesh: &HalfedgeMesh, normals: &[[f64; 3]], v: u32, p: [f64; 3], cos_t
         star = add(star, mesh.face_normal2(f));
     }
     let ls = norm(star);
-    let star = if ls > 0.0 { scale(star, 1.0 / ls) } else { [0.0; 3] };
+    let star = if ls > 0.0 {
+        scale(star, 1.0 / ls)
+    } else {
+        [0.0; 3]
+    };
     mesh.vertex_faces(v).all(|f| {
-        let c = mesh
-            .face_vertices(f)
-            .map(|x| if x == v { p } else { mesh.positions[x as usize] });
+        let c = mesh.face_vertices(f).map(|x| {
+            if x == v {
+                p
+            } else {
+                mesh.positions[x as usize]
+            }
+        });
         let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
         let l = norm(n);
-        if !(l > 0.0) {
+        if l.is_nan() || l <= 0.0 {
             return false;
         }
         let before = mesh.face_vertices(f).map(|x| mesh.positions[x as usize]);
@@ -78,7 +89,10 @@ pub fn place_new_vertex(mesh: &mut HalfedgeMesh, reference: &Reference, v: u32, 
             .map_or(NONE, |e| mesh.edge_line[e]);
         reference.project_line(p, line, hint)
     } else {
-        let patch = mesh.vertex_faces(v).next().map_or(NONE, |f| mesh.face_patch[f as usize]);
+        let patch = mesh
+            .vertex_faces(v)
+            .next()
+            .map_or(NONE, |f| mesh.face_patch[f as usize]);
         reference.project_patch(p, patch, hint)
     };
     let Some(pr) = pr else {
@@ -95,9 +109,13 @@ pub fn place_new_vertex(mesh: &mut HalfedgeMesh, reference: &Reference, v: u32, 
         .collect();
     let ok = normals.iter().all(|&(f, old)| {
         let before = mesh.face_vertices(f).map(|x| mesh.positions[x as usize]);
-        let c = mesh
-            .face_vertices(f)
-            .map(|x| if x == v { pr.point } else { mesh.positions[x as usize] });
+        let c = mesh.face_vertices(f).map(|x| {
+            if x == v {
+                pr.point
+            } else {
+                mesh.positions[x as usize]
+            }
+        });
         let n = cross(sub(c[1], c[0]), sub(c[2], c[0]));
         let l = norm(n);
         l > 0.0 && keeps_shape(before, c) && (old == [0.0; 3] || dot(n, old) >= cos_turn * l)
@@ -163,7 +181,7 @@ fn plan(mesh: &HalfedgeMesh, normals: &[[f64; 3]], v: u32) -> Option<Plan> {
         nrm = add(nrm, scale(normals[f as usize], area));
         patch = mesh.face_patch[f as usize];
     }
-    if !(wsum > 0.0) || patch == NONE {
+    if wsum.is_nan() || wsum <= 0.0 || patch == NONE {
         return Some(Plan::Free { target: p, patch });
     }
     let c = scale(acc, 1.0 / wsum);
@@ -199,7 +217,7 @@ pub fn relax_and_project(
             let plan = plan(m, &normals, v)?;
             let p = m.positions[v as usize];
             let hint = m.vertex_hint[v as usize];
-            let (target, project): (_, Box<dyn Fn([f64; 3]) -> Option<Projected>>) = match plan {
+            let (target, project): (_, Box<ProjectFn>) = match plan {
                 Plan::Free { target, patch } => (
                     target,
                     Box::new(move |q| reference.project_patch(q, patch, hint)),

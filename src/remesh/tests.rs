@@ -1,53 +1,46 @@
-use super::*;
-use crate::mesh::halfedge::HalfedgeMesh;
+use super::field::{Source, SourceField};
+use crate::geometry::closest_point_triangle;
 
-fn cube(n: usize) -> Grid {
-    // Unit cube, each face an n × n grid.
-    let mut v = Vec::new();
-    let mut t = Vec::new();
-    let faces: [([f64; 3], [f64; 3], [f64; 3]); 6] = [
-        ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]),
-        ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),
-        ([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
-        ([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]),
-        ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
-        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]),
-    ];
-    for (o, u, w) in faces {
-        let base = v.len() as u32;
-        for j in 0..=n {
-            for i in 0..=n {
-                let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
-                v.push([0, 1, 2].map(|k| o[k] + a * u[k] + b * w[k]));
-            }
-        }
-        let id = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
-        for j in 0..n {
-            for i in 0..n {
-                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
-    }
-    Grid::from_arrays(v, t, None, &BuildOptions { weld_relative_tolerance: Some(1e-9), orient: true }).unwrap()
+/// Deterministic pseudo-random numbers in [0, 1).
+fn rng(seed: &mut u64) -> f64 {
+    *seed = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*seed >> 11) as f64 / (1u64 << 53) as f64
 }
 
 #[test]
-fn split_pass_terminates() {
-    let g = cube(1);
-    let f = Features::detect(&g, 30.0);
-    let (mut m, _) = HalfedgeMesh::from_grid(&g, Some(&f));
-    for v in 0..m.n_vertices() {
-        m.vertex_size[v] = 0.2;
+fn source_field_equals_brute_force() {
+    let mut seed = 7;
+    let p = |s: &mut u64| [rng(s) * 10.0, rng(s) * 10.0, rng(s) * 10.0];
+    let mut sources: Vec<Source> = Vec::new();
+    for i in 0..300 {
+        let a = p(&mut seed);
+        let b = p(&mut seed);
+        let c = p(&mut seed);
+        // Points, segments and triangles.
+        let prim = match i % 3 {
+            0 => [a; 3],
+            1 => [a, b, b],
+            _ => [a, b, c],
+        };
+        sources.push((prim, 0.1 + rng(&mut seed)));
     }
-    let area = |m: &HalfedgeMesh| m.faces().map(|f| 0.5 * crate::geometry::norm(m.face_normal2(f))).sum::<f64>();
-    let n = ops::split_long(&mut m);
-    m.check().unwrap();
-    eprintln!("area {}", area(&m));
-    let mut pos: Vec<_> = m.vertices().map(|v| m.positions[v as usize]).collect();
-    pos.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    pos.dedup();
-    eprintln!("distinct {} of {}", pos.len(), m.vertex_count());
-    eprintln!("{n} splits, {} faces", m.face_count());
-    assert!(n < 10_000);
+    sources.push(([[0.0; 3]; 3], f64::INFINITY)); // ignored
+    let slope = 0.3;
+    let field = SourceField::new(&sources, slope);
+    for _ in 0..500 {
+        let q = [
+            rng(&mut seed) * 14.0 - 2.0,
+            rng(&mut seed) * 14.0 - 2.0,
+            rng(&mut seed) * 14.0 - 2.0,
+        ];
+        let brute = sources
+            .iter()
+            .filter(|s| s.1.is_finite())
+            .map(|(t, h)| h + slope * closest_point_triangle(q, t[0], t[1], t[2]).dist2.sqrt())
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(field.eval(q), brute, "at {q:?}");
+    }
+    assert_eq!(SourceField::new(&[], slope).eval([0.0; 3]), f64::INFINITY);
 }

@@ -111,14 +111,13 @@ impl HalfedgeMesh {
         let mut edge_of: HashMap<u64, u32> = HashMap::with_capacity(2 * nf);
         for f in 0..nf {
             let c = if rejected[f] {
-                let c = tris[f].map(|o| {
+                tris[f].map(|o| {
                     let v = mesh.add_vertex(verts[o as usize]);
                     mesh.vertex_origin[v as usize] = o;
                     mesh.vertex_flags[v as usize] = V_LOCKED | V_CORNER;
                     report.extra_copies += 1;
                     v
-                });
-                c
+                })
             } else {
                 corner[f]
             };
@@ -174,7 +173,10 @@ impl HalfedgeMesh {
         // Edge flags from the input edges.
         for e in 0..mesh.n_edges() as u32 {
             let [a, b] = mesh.edge_vertices(e);
-            let (oa, ob) = (mesh.vertex_origin[a as usize], mesh.vertex_origin[b as usize]);
+            let (oa, ob) = (
+                mesh.vertex_origin[a as usize],
+                mesh.vertex_origin[b as usize],
+            );
             let Some(ie) = topo.find_edge(oa, ob) else {
                 continue;
             };
@@ -260,8 +262,10 @@ fn fans(grid: &Grid, rejected: &[bool]) -> (Vec<[u32; 3]>, Vec<u32>, Vec<bool>) 
             let t = tris[f as usize];
             let k = t.iter().position(|&x| x == v32).unwrap_or(0);
             // Outgoing edge v → t[k+1] is face edge k; incoming t[k+2] → v is edge k+2.
-            for (slot, w, outgoing) in [(k, t[(k + 1) % 3], true), ((k + 2) % 3, t[(k + 2) % 3], false)]
-            {
+            for (slot, w, outgoing) in [
+                (k, t[(k + 1) % 3], true),
+                ((k + 2) % 3, t[(k + 2) % 3], false),
+            ] {
                 let e = topo.face_edges[f as usize][slot] as usize;
                 let ef = topo.faces_of_edge(e);
                 if ef.len() != 2 {

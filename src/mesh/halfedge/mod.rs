@@ -444,7 +444,10 @@ impl HalfedgeMesh {
             for h in [2 * e, 2 * e + 1] {
                 let hu = h as usize;
                 let (n, p) = (self.next[hu], self.prev[hu]);
-                if n >= nh || p >= nh || self.edel[(n >> 1) as usize] || self.edel[(p >> 1) as usize]
+                if n >= nh
+                    || p >= nh
+                    || self.edel[(n >> 1) as usize]
+                    || self.edel[(p >> 1) as usize]
                 {
                     return Err(format!("half-edge {h}: bad next/prev"));
                 }
@@ -519,10 +522,15 @@ impl HalfedgeMesh {
                 }
             }
             if count != degree[v as usize] {
-                return Err(format!("vertex {v}: {count} edges in its fan, {} in all", degree[v as usize]));
+                return Err(format!(
+                    "vertex {v}: {count} edges in its fan, {} in all",
+                    degree[v as usize]
+                ));
             }
             if boundary > 1 || (boundary == 1 && self.hface[h0 as usize] != NONE) {
-                return Err(format!("vertex {v}: non-manifold or stale boundary half-edge"));
+                return Err(format!(
+                    "vertex {v}: non-manifold or stale boundary half-edge"
+                ));
             }
         }
         Ok(())

@@ -273,7 +273,9 @@ impl HalfedgeMesh {
     /// Errors (and changes nothing) when [`HalfedgeMesh::is_flip_ok`] is false.
     pub fn flip(&mut self, e: u32) -> Result<()> {
         if !self.is_flip_ok(e) {
-            return Err(Error::InvalidArgument(format!("edge {e} cannot be flipped")));
+            return Err(Error::InvalidArgument(format!(
+                "edge {e} cannot be flipped"
+            )));
         }
         let a0 = 2 * e;
         let b0 = a0 + 1;

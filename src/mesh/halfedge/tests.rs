@@ -50,9 +50,14 @@ fn builds_closed_and_open() {
     let g = cube();
     let (m, r) = HalfedgeMesh::from_grid(&g, None);
     m.check().unwrap();
-    assert_eq!((m.vertex_count(), m.edge_count(), m.face_count()), (8, 18, 12));
+    assert_eq!(
+        (m.vertex_count(), m.edge_count(), m.face_count()),
+        (8, 18, 12)
+    );
     assert_eq!(r.split_vertices + r.detached_faces + r.locked_edges, 0);
-    assert!(m.vertices().all(|v| !m.is_boundary_vertex(v) && m.valence(v) >= 3));
+    assert!(m
+        .vertices()
+        .all(|v| !m.is_boundary_vertex(v) && m.valence(v) >= 3));
 
     let g = plate(3);
     let f = Features::detect(&g, 30.0);
@@ -177,10 +182,16 @@ fn non_manifold_edges_are_split_and_merged_back() {
     t.extend(c.triangles().iter().map(|x| x.map(|i| i + o)));
     let o2 = v.len() as u32;
     // Second cube touching the first at its corner (4, 1, 1) = vertex o + 7.
-    v.extend(c.vertices().iter().map(|p| [p[0] + 4.0, p[1] + 1.0, p[2] + 1.0]));
-    t.extend(c.triangles().iter().map(|x| {
-        x.map(|i| if i == 0 { o + 7 } else { i + o2 })
-    }));
+    v.extend(
+        c.vertices()
+            .iter()
+            .map(|p| [p[0] + 4.0, p[1] + 1.0, p[2] + 1.0]),
+    );
+    t.extend(
+        c.triangles()
+            .iter()
+            .map(|x| x.map(|i| if i == 0 { o + 7 } else { i + o2 })),
+    );
     let g = grid(v, t);
     let topo: &Topology = g.topology();
     assert_eq!(topo.non_manifold_edge_count(), 1);
