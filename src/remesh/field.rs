@@ -101,8 +101,8 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Sour
     // Strips: a smooth patch narrower than its target length (a plate's rim
     // between two sharp edges) is meshed across its width, so its rims are
     // refined to about that width and the triangles spanning it are not
-    // slivers. Width: twice the area over
-    // the perimeter (exact for a long strip, the radius of a disc).
+    // slivers. Width: twice the area over the perimeter (exact for a long
+    // strip, the radius of a disc).
     {
         let np = features.patch_count as usize;
         let mut area = vec![0.0; np];
@@ -133,28 +133,13 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Sour
             }
         };
         let floor_p = |p: usize| s.line_min_ratio * base[p];
-        // Strips narrower than the floor (a foil's edge) are left unrefined,
-        // and so are the strips beside them: refining a rim they share would
-        // only multiply the slivers spanning the narrower one.
-        let mut beside_foil = vec![false; np];
-        for e in 0..topo.edges.len() {
-            let fs = topo.faces_of_edge(e);
-            for &a in fs {
-                for &b in fs {
-                    let (pa, pb) = (
-                        features.face_patch[a as usize] as usize,
-                        features.face_patch[b as usize] as usize,
-                    );
-                    if pa != pb && STRIP_RATIO * width(pb) < floor_p(pb) {
-                        beside_foil[pa] = true;
-                    }
-                }
-            }
-        }
+        // Strips narrower than the floor (a foil's edge) are left unrefined:
+        // refining their rims to the floor would only multiply the slivers
+        // spanning them.
         for (f, t) in tris.iter().enumerate() {
             let p = features.face_patch[f] as usize;
             let c = STRIP_RATIO * width(p);
-            if c < base[p] && c >= floor_p(p) && !beside_foil[p] {
+            if c < base[p] && c >= floor_p(p) {
                 out.push((t.map(|i| v[i as usize]), c));
             }
         }
