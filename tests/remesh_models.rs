@@ -35,22 +35,8 @@ fn size_driven_mode_follows_a_computed_field() {
     };
     g.compute_sizes(&SizeParams::default()).unwrap();
     let out = remesh_sized(&g, &g, &RemeshParams::default()).unwrap();
-    let v = out.grid.vertices();
-    let ratios: Vec<f64> = out
-        .grid
-        .topology()
-        .edges
-        .iter()
-        .map(|e| {
-            let [a, b] = e.map(|i| v[i as usize]);
-            let m = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
-            let l = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt();
-            l / g.closest(m, None).unwrap().size
-        })
-        .collect();
-    let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
-    let within =
-        ratios.iter().filter(|r| (0.6..=1.5).contains(*r)).count() as f64 / ratios.len() as f64;
+    let (mean, within) =
+        quality::length_ratios(&out.grid, |p, hint| g.query_size_hinted(p, hint)).unwrap();
     assert!((0.85..=1.2).contains(&mean), "mean {mean}");
     assert!(within >= 0.9, "within {within}");
     let a = quality::evaluate(&g, &out.grid, Some(&out.feature_edges), 30.0, 20_000);

@@ -267,25 +267,7 @@ fn bad_parameters_are_errors() {
 
 /// Mean of length / h(midpoint) over the output edges, and the share within [0.6, 1.5].
 fn size_ratios(out: &Grid, sizing: &Grid) -> (f64, f64) {
-    let v = out.vertices();
-    let topo = out.topology();
-    let r: Vec<f64> = topo
-        .edges
-        .iter()
-        .map(|e| {
-            let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
-            let m = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
-            let l = [0, 1, 2]
-                .map(|k| (a[k] - b[k]).powi(2))
-                .iter()
-                .sum::<f64>()
-                .sqrt();
-            l / sizing.query_size(m).unwrap()
-        })
-        .collect();
-    let mean = r.iter().sum::<f64>() / r.len() as f64;
-    let within = r.iter().filter(|&&x| (0.6..=1.5).contains(&x)).count() as f64 / r.len() as f64;
-    (mean, within)
+    quality::length_ratios(out, |p, hint| sizing.query_size_hinted(p, hint)).unwrap()
 }
 
 fn sized(g: &Grid, h: impl Fn([f64; 3]) -> f64) -> Grid {

@@ -3,7 +3,6 @@
 
 use abgs::remesh::{self, quality, RemeshParams, Remeshed, TargetLength};
 use abgs::{Error, Grid, Result};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Samples per surface and per feature set for `--check`.
@@ -105,10 +104,10 @@ pub fn run(input: &Path, output: &Path, args: &GridArgs) -> Result<bool> {
         CHECK_SAMPLES,
     );
     let ratios = match &sizing {
-        Some(s) => length_ratios(&r.grid, |p, hint| s.query_size_hinted(p, hint)),
+        Some(s) => quality::length_ratios(&r.grid, |p, hint| s.query_size_hinted(p, hint)),
         None => {
             let l0 = r.report.target_length;
-            length_ratios(&r.grid, |_, _| Ok(l0))
+            quality::length_ratios(&r.grid, |_, _| Ok(l0))
         }
     };
     pb.finish_and_clear();
@@ -163,40 +162,6 @@ fn print_report(output: &Path, input: &Grid, r: &Remeshed, size_from: Option<&Pa
             eprintln!("  - {i}");
         }
     }
-}
-
-/// Per unique edge of `grid`: its length over the target `h` at its midpoint
-/// (`h(point, hint)`, hinted per chunk); returns the mean and the share in [0.6, 1.5].
-fn length_ratios(
-    grid: &Grid,
-    h: impl Fn([f64; 3], &mut u32) -> Result<f64> + Sync,
-) -> Result<(f64, f64)> {
-    let v = grid.vertices();
-    let edges = &grid.topology().edges;
-    let r: Vec<f64> = edges
-        .par_chunks(1024)
-        .map(|chunk| {
-            let mut hint = u32::MAX;
-            chunk
-                .iter()
-                .map(|e| {
-                    let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
-                    let m = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
-                    let l = [0, 1, 2]
-                        .map(|k| (a[k] - b[k]).powi(2))
-                        .iter()
-                        .sum::<f64>()
-                        .sqrt();
-                    Ok(l / h(m, &mut hint)?)
-                })
-                .collect::<Result<Vec<f64>>>()
-        })
-        .collect::<Result<Vec<_>>>()?
-        .concat();
-    let n = r.len().max(1) as f64;
-    let mean = r.iter().sum::<f64>() / n;
-    let within = r.iter().filter(|&&x| (0.6..=1.5).contains(&x)).count() as f64 / n;
-    Ok((mean, within))
 }
 
 /// Prints the acceptance numbers on stdout; returns false when a check fails.

@@ -433,7 +433,7 @@ pub unsafe extern "C" fn abgs_grid_free(grid: *mut abgs_grid) -> abgs_status {
 ///
 /// # Safety
 /// A non-NULL `p` must point to `capacity` writable items.
-unsafe fn checked_out<'a, T>(
+pub(crate) unsafe fn checked_out<'a, T>(
     p: *mut T,
     capacity: usize,
     needed: usize,

@@ -3,7 +3,7 @@
 //! (feature edges) and could not do (issues), held in the new grid's handle.
 
 use super::boundary::*;
-use super::grid::abgs_grid;
+use super::grid::{abgs_grid, checked_out};
 use crate::remesh::{self, RemeshParams, TargetLength};
 use std::ffi::c_char;
 
@@ -316,17 +316,8 @@ pub unsafe extern "C" fn abgs_grid_remesh_copy_feature_edges(
         let h = unsafe { req(grid, "grid")? };
         let _g = h.read()?;
         let flat = info(h)?.feature_edges.as_flattened();
-        if out_edges.is_null() {
-            return err(abgs_status::ABGS_ERR_NULL, "out_edges is NULL");
-        }
-        if capacity < flat.len() {
-            return err(
-                abgs_status::ABGS_ERR_BUFFER_TOO_SMALL,
-                format!("out_edges holds {capacity}, {} needed", flat.len()),
-            );
-        }
-        // SAFETY: the caller guarantees `capacity` >= flat.len() writable indices.
-        unsafe { slice_mut(out_edges, flat.len(), "out_edges")? }.copy_from_slice(flat);
+        // SAFETY: the caller guarantees `capacity` writable indices (or NULL, reported).
+        unsafe { checked_out(out_edges, capacity, flat.len(), "out_edges")? }.copy_from_slice(flat);
         Ok(())
     })
 }

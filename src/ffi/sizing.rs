@@ -2,7 +2,7 @@
 //! gradation, the Laplace–Beltrami operator and the edge list it is indexed by.
 
 use super::boundary::*;
-use super::grid::abgs_grid;
+use super::grid::{abgs_grid, checked_out};
 use crate::sizing::{Gradation, SizeParams, SizeSource, SourceShape};
 
 /// Source kind: a point (`points[0..3]`).
@@ -310,17 +310,8 @@ pub unsafe extern "C" fn abgs_grid_copy_edges(
         // SAFETY: a grid from this library or NULL (checked).
         let g = unsafe { req(grid, "grid")? }.read()?;
         let flat = g.topology().edges.as_flattened();
-        if out_edges.is_null() {
-            return err(abgs_status::ABGS_ERR_NULL, "out_edges is NULL");
-        }
-        if capacity < flat.len() {
-            return err(
-                abgs_status::ABGS_ERR_BUFFER_TOO_SMALL,
-                format!("out_edges holds {capacity}, {} needed", flat.len()),
-            );
-        }
-        // SAFETY: the caller guarantees `capacity` >= flat.len() writable indices.
-        unsafe { slice_mut(out_edges, flat.len(), "out_edges")? }.copy_from_slice(flat);
+        // SAFETY: the caller guarantees `capacity` writable indices (or NULL, reported).
+        unsafe { checked_out(out_edges, capacity, flat.len(), "out_edges")? }.copy_from_slice(flat);
         Ok(())
     })
 }

@@ -45,8 +45,8 @@ pub struct CapSettings {
 /// the cap on it.
 pub type Source = ([[f64; 3]; 3], f64);
 
-/// The cap sources (only finite caps). O(F).
-pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Source> {
+/// The cap sources (only finite caps); `width` is [`patch_widths`]. O(F).
+pub fn length_cap(grid: &Grid, features: &Features, width: &[f64], s: &CapSettings) -> Vec<Source> {
     let nv = grid.vertices().len();
     let mut cap = vec![f64::INFINITY; nv];
     let mut out: Vec<Source> = Vec::new();
@@ -101,44 +101,22 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Sour
     // Strips: a smooth patch narrower than its target length (a plate's rim
     // between two sharp edges) is meshed across its width, so its rims are
     // refined to about that width and the triangles spanning it are not
-    // slivers. Width: twice the area over the perimeter (exact for a long
-    // strip, the radius of a disc).
+    // slivers. Width: see [`patch_widths`].
     {
-        let np = features.patch_count as usize;
-        let mut area = vec![0.0; np];
-        let mut perimeter = vec![0.0; np];
-        let mut base = vec![f64::INFINITY; np];
+        let mut base = vec![f64::INFINITY; width.len()];
         for (f, t) in tris.iter().enumerate() {
             let p = features.face_patch[f] as usize;
-            area[p] += crate::geometry::triangle_area(
-                v[t[0] as usize],
-                v[t[1] as usize],
-                v[t[2] as usize],
-            );
             for &i in t {
                 base[p] = base[p].min(s.base[i as usize]);
             }
-            for &e in &topo.face_edges[f] {
-                if features.is_feature(e as usize) {
-                    let [a, b] = topo.edges[e as usize];
-                    perimeter[p] += norm(sub(v[a as usize], v[b as usize]));
-                }
-            }
         }
-        let width = |p: usize| {
-            if perimeter[p] > 0.0 {
-                2.0 * area[p] / perimeter[p]
-            } else {
-                f64::INFINITY
-            }
-        };
         let floor_p = |p: usize| s.line_min_ratio * base[p];
         // Strips narrower than the floor (a foil's edge) are left unrefined:
         // refining their rims to the floor would only multiply the slivers
         // spanning them.
         for (f, t) in tris.iter().enumerate() {
             let p = features.face_patch[f] as usize;
-            let c = STRIP_RATIO * width(p);
+            let c = STRIP_RATIO * width[p];
             if c < base[p] && c >= floor_p(p) {
                 out.push((t.map(|i| v[i as usize]), c));
             }
@@ -206,6 +184,36 @@ pub fn length_cap(grid: &Grid, features: &Features, s: &CapSettings) -> Vec<Sour
         }
     }
     out
+}
+
+/// Width of each smooth patch: twice its area over the length of its feature
+/// rims (exact for a long strip, the radius of a disc; ∞ for a patch without
+/// feature rims). O(F).
+pub fn patch_widths(grid: &Grid, features: &Features) -> Vec<f64> {
+    let np = features.patch_count as usize;
+    let (v, topo) = (grid.vertices(), grid.topology());
+    let mut area = vec![0.0; np];
+    let mut perimeter = vec![0.0; np];
+    for (f, t) in grid.triangles().iter().enumerate() {
+        let p = features.face_patch[f] as usize;
+        area[p] +=
+            crate::geometry::triangle_area(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
+        for &e in &topo.face_edges[f] {
+            if features.is_feature(e as usize) {
+                let [a, b] = topo.edges[e as usize];
+                perimeter[p] += norm(sub(v[a as usize], v[b as usize]));
+            }
+        }
+    }
+    (0..np)
+        .map(|p| {
+            if perimeter[p] > 0.0 {
+                2.0 * area[p] / perimeter[p]
+            } else {
+                f64::INFINITY
+            }
+        })
+        .collect()
 }
 
 /// A graded size field from sources: `f(x) = min_i (h_i + slope·d(x, S_i))`

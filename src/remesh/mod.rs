@@ -252,9 +252,11 @@ fn run(
             .collect(),
         (None, None) => vec![f64::INFINITY; input.vertices().len()],
     };
+    let widths = field::patch_widths(input, &features);
     let cap = field::length_cap(
         input,
         &features,
+        &widths,
         &field::CapSettings {
             base,
             crease_tolerance: params.fidelity,
@@ -302,7 +304,7 @@ fn run(
         cap: &cap,
         sizing,
     };
-    let thin = thin_patches(input, &features, &reference);
+    let thin = thin_patches(input, &features, &widths, &reference);
     reference.thin_patch = &thin;
     let thin_patches = thin.iter().filter(|&&x| x).count();
     let lim = Limits {
@@ -401,29 +403,28 @@ fn run(
 /// Patches narrower than half their target length (twice the area over the
 /// perimeter): such a strip cannot hold vertices inside (they would sit on
 /// its rims and make flat faces), so it is remeshed from its rims only.
-fn thin_patches(input: &Grid, features: &Features, reference: &Reference) -> Vec<bool> {
-    let np = features.patch_count as usize;
-    let (v, t, topo) = (input.vertices(), input.triangles(), input.topology());
-    let mut area = vec![0.0; np];
-    let mut perimeter = vec![0.0; np];
-    let mut target = vec![f64::INFINITY; np];
-    let vt: Vec<f64> = v.iter().map(|&p| reference.target(p)).collect();
-    for (f, tri) in t.iter().enumerate() {
+fn thin_patches(
+    input: &Grid,
+    features: &Features,
+    width: &[f64],
+    reference: &Reference,
+) -> Vec<bool> {
+    let mut target = vec![f64::INFINITY; width.len()];
+    let vt: Vec<f64> = input
+        .vertices()
+        .iter()
+        .map(|&p| reference.target(p))
+        .collect();
+    for (f, tri) in input.triangles().iter().enumerate() {
         let p = features.face_patch[f] as usize;
-        let [a, b, c] = tri.map(|i| v[i as usize]);
-        area[p] += crate::geometry::triangle_area(a, b, c);
         for &i in tri {
             target[p] = target[p].min(vt[i as usize]);
         }
-        for &e in &topo.face_edges[f] {
-            if features.is_feature(e as usize) {
-                let [x, y] = topo.edges[e as usize];
-                perimeter[p] += crate::geometry::dist2(v[x as usize], v[y as usize]).sqrt();
-            }
-        }
     }
-    (0..np)
-        .map(|p| perimeter[p] > 0.0 && 2.0 * area[p] / perimeter[p] < 0.5 * target[p])
+    width
+        .iter()
+        .zip(&target)
+        .map(|(&w, &t)| w < 0.5 * t)
         .collect()
 }
 

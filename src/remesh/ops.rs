@@ -336,25 +336,30 @@ pub fn flip_geometry_ok(mesh: &HalfedgeMesh, e: u32, lim: &Limits, floor_deg: f6
     q_new >= q_old.min(floor_deg)
 }
 
+/// Edge `e` may be flipped (live, not a feature or locked, topologically
+/// flippable, not joining two locked vertices): its ends and apexes `[a, b, c, d]`.
+fn flip_candidate(mesh: &HalfedgeMesh, e: u32) -> Option<[u32; 4]> {
+    if mesh.edge_deleted(e)
+        || mesh.edge_flags[e as usize] & (E_FEATURE | E_LOCKED) != 0
+        || !mesh.is_flip_ok(e)
+    {
+        return None;
+    }
+    let [a, b] = mesh.edge_vertices(e);
+    let [c, d] = mesh.flip_apexes(e);
+    let locked = |v: u32| mesh.vertex_flags[v as usize] & V_LOCKED != 0;
+    (!(locked(c) && locked(d))).then_some([a, b, c, d])
+}
+
 /// Flips every interior non-feature edge whose flip brings the valences of its
 /// four vertices closer to ideal (6 inside, 4 on a boundary) without worsening
 /// angles. Returns the number of flips.
 pub fn flip_valence(mesh: &mut HalfedgeMesh, lim: &Limits) -> usize {
     let mut count = 0;
     for e in 0..mesh.n_edges() as u32 {
-        if mesh.edge_deleted(e)
-            || mesh.edge_flags[e as usize] & (E_FEATURE | E_LOCKED) != 0
-            || !mesh.is_flip_ok(e)
-        {
+        let Some([a, b, c, d]) = flip_candidate(mesh, e) else {
             continue;
-        }
-        let [a, b] = mesh.edge_vertices(e);
-        let [c, d] = mesh.flip_apexes(e);
-        if mesh.vertex_flags[c as usize] & V_LOCKED != 0
-            && mesh.vertex_flags[d as usize] & V_LOCKED != 0
-        {
-            continue;
-        }
+        };
         let mut before = 0;
         let mut after = 0;
         for (v, delta) in [(a, -1), (b, -1), (c, 1), (d, 1)] {
@@ -386,19 +391,9 @@ pub fn flip_angles(mesh: &mut HalfedgeMesh, lim: &Limits, sweeps: usize) -> usiz
     for _ in 0..sweeps {
         let mut any = false;
         for e in 0..mesh.n_edges() as u32 {
-            if mesh.edge_deleted(e)
-                || mesh.edge_flags[e as usize] & (E_FEATURE | E_LOCKED) != 0
-                || !mesh.is_flip_ok(e)
-            {
+            let Some([a, b, c, d]) = flip_candidate(mesh, e) else {
                 continue;
-            }
-            let [a, b] = mesh.edge_vertices(e);
-            let [c, d] = mesh.flip_apexes(e);
-            if mesh.vertex_flags[c as usize] & V_LOCKED != 0
-                && mesh.vertex_flags[d as usize] & V_LOCKED != 0
-            {
-                continue;
-            }
+            };
             let [pa, pb, pc, pd] = [a, b, c, d].map(|x| mesh.positions[x as usize]);
             let old = max_angle(pa, pb, pc).max(max_angle(pb, pa, pd));
             let new = max_angle(pa, pd, pc).max(max_angle(pd, pb, pc));

@@ -3,7 +3,7 @@
 //! feature lines (by dense sampling and exact closest points), bodies, and
 //! boundary / non-manifold edges that are not on the input's.
 
-use super::reference::closest_filtered;
+use crate::error::Result;
 use crate::geometry::{dist2, lerp};
 use crate::mesh::features::{BOUNDARY, NON_MANIFOLD};
 use crate::mesh::{Features, Grid};
@@ -61,7 +61,8 @@ impl Segments {
         }
     }
     fn distance(&self, p: [f64; 3]) -> f64 {
-        closest_filtered(&self.bvh, p, u32::MAX, |_| true)
+        self.bvh
+            .closest(p, None)
             .map_or(f64::INFINITY, |h| h.closest.dist2.sqrt())
     }
     /// About `n` points spread evenly by length, ends included.
@@ -139,6 +140,42 @@ pub fn hausdorff(a: &Grid, b: &Grid, n: usize, seed: u64) -> f64 {
             .reduce(|| 0.0, f64::max)
     };
     one(a, b).max(one(b, a))
+}
+
+/// Per unique edge of `grid`: its length over the target `h` at its midpoint
+/// (`h(point, hint)`, hinted per chunk); returns the mean and the share in
+/// [0.6, 1.5], the size-driven acceptance measures. O(E) queries, parallel;
+/// the first error of `h` is returned.
+pub fn length_ratios(
+    grid: &Grid,
+    h: impl Fn([f64; 3], &mut u32) -> Result<f64> + Sync,
+) -> Result<(f64, f64)> {
+    let v = grid.vertices();
+    let edges = &grid.topology().edges;
+    let r: Vec<f64> = edges
+        .par_chunks(1024)
+        .map(|chunk| {
+            let mut hint = u32::MAX;
+            chunk
+                .iter()
+                .map(|e| {
+                    let (a, b) = (v[e[0] as usize], v[e[1] as usize]);
+                    let m = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+                    let l = [0, 1, 2]
+                        .map(|k| (a[k] - b[k]).powi(2))
+                        .iter()
+                        .sum::<f64>()
+                        .sqrt();
+                    Ok(l / h(m, &mut hint)?)
+                })
+                .collect::<Result<Vec<f64>>>()
+        })
+        .collect::<Result<Vec<_>>>()?
+        .concat();
+    let n = r.len().max(1) as f64;
+    let mean = r.iter().sum::<f64>() / n;
+    let within = r.iter().filter(|&&x| (0.6..=1.5).contains(&x)).count() as f64 / n;
+    Ok((mean, within))
 }
 
 /// Evaluates `output` against `input` with `n` samples per surface and per

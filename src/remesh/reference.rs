@@ -3,83 +3,10 @@
 //! restricted to one feature line, and the target edge length carried along.
 
 use super::field::SourceField;
-use crate::geometry::{closest_point_triangle, dist2, dot, norm, sub, ClosestPoint};
+use crate::geometry::{dist2, dot, norm, sub};
 use crate::mesh::halfedge::{HalfedgeMesh, E_FEATURE, NONE, V_CORNER, V_FEATURE};
 use crate::mesh::Grid;
-use crate::spatial::{Bvh, ClosestHit, MAX_DEPTH};
-
-/// Exact closest point to `p` among the primitives of `bvh` accepted by `keep`
-/// (ties to the lowest index, so the answer depends only on `p`). `hint` seeds
-/// the bound when it is accepted. `None` when nothing is accepted.
-pub fn closest_filtered(
-    bvh: &Bvh,
-    p: [f64; 3],
-    hint: u32,
-    keep: impl Fn(u32) -> bool,
-) -> Option<ClosestHit> {
-    if bvh.nodes.is_empty() {
-        return None;
-    }
-    let mut best_d2 = f64::INFINITY;
-    let mut best_tri = u32::MAX;
-    let mut best_cp = ClosestPoint {
-        point: p,
-        bary: [1.0, 0.0, 0.0],
-        dist2: f64::INFINITY,
-    };
-    if let Some(&slot) = bvh.triangle_prim.get(hint as usize) {
-        if keep(hint) {
-            let c = &bvh.prim_corners[slot as usize];
-            best_cp = closest_point_triangle(p, c[0], c[1], c[2]);
-            best_d2 = best_cp.dist2;
-            best_tri = hint;
-        }
-    }
-    let mut stack = [0u32; MAX_DEPTH];
-    let mut sp = 0usize;
-    let mut node = 0usize;
-    loop {
-        let n = &bvh.nodes[node];
-        if n.bbox.distance2(&p) <= best_d2 {
-            if n.is_leaf() {
-                let s = n.start as usize;
-                for slot in s..s + n.count as usize {
-                    let tri = bvh.prim_triangle[slot];
-                    if !keep(tri) {
-                        continue;
-                    }
-                    let c = &bvh.prim_corners[slot];
-                    let cp = closest_point_triangle(p, c[0], c[1], c[2]);
-                    if cp.dist2 < best_d2 || (cp.dist2 == best_d2 && tri < best_tri) {
-                        best_d2 = cp.dist2;
-                        best_tri = tri;
-                        best_cp = cp;
-                    }
-                }
-            } else {
-                let (l, r) = (node + 1, n.start as usize);
-                let dl = bvh.nodes[l].bbox.distance2(&p);
-                let dr = bvh.nodes[r].bbox.distance2(&p);
-                let (near, far) = if dl <= dr { (l, r) } else { (r, l) };
-                if sp < MAX_DEPTH {
-                    stack[sp] = far as u32;
-                    sp += 1;
-                }
-                node = near;
-                continue;
-            }
-        }
-        if sp == 0 {
-            break;
-        }
-        sp -= 1;
-        node = stack[sp] as usize;
-    }
-    (best_tri != u32::MAX).then_some(ClosestHit {
-        triangle: best_tri,
-        closest: best_cp,
-    })
-}
+use crate::spatial::Bvh;
 
 /// Feature segments of the input, grouped in lines, with a BVH over them
 /// (each segment stored as a degenerate triangle `[a, b, b]`).
@@ -241,7 +168,8 @@ impl Reference<'_> {
     /// patch has none near). `None` only for an empty grid.
     pub fn project_patch(&self, p: [f64; 3], patch: u32, hint: u32) -> Option<Projected> {
         let bvh = self.grid.bvh();
-        let hit = closest_filtered(bvh, p, hint, |t| self.face_patch[t as usize] == patch)
+        let hit = bvh
+            .closest_filtered(p, Some(hint), |t| self.face_patch[t as usize] == patch)
             .or_else(|| bvh.closest(p, None))?;
         let b = hit.closest.bary;
         let t = hit.triangle as usize;
@@ -269,9 +197,10 @@ impl Reference<'_> {
 
     /// Closest point of `p` on feature line `line` of the input.
     pub fn project_line(&self, p: [f64; 3], line: u32, hint: u32) -> Option<Projected> {
-        let hit = closest_filtered(&self.lines.bvh, p, hint, |s| {
-            self.lines.seg_line[s as usize] == line
-        })?;
+        let hit = self
+            .lines
+            .bvh
+            .closest_filtered(p, Some(hint), |s| self.lines.seg_line[s as usize] == line)?;
         Some(Projected {
             point: hit.closest.point,
             hint: hit.triangle,
@@ -282,9 +211,9 @@ impl Reference<'_> {
 
     /// Distance from `p` to the nearest segment of line `line` (∞ if none).
     pub fn distance_to_line(&self, p: [f64; 3], line: u32, hint: u32) -> f64 {
-        closest_filtered(&self.lines.bvh, p, hint, |s| {
-            self.lines.seg_line[s as usize] == line
-        })
-        .map_or(f64::INFINITY, |h| dist2(h.closest.point, p).sqrt())
+        self.lines
+            .bvh
+            .closest_filtered(p, Some(hint), |s| self.lines.seg_line[s as usize] == line)
+            .map_or(f64::INFINITY, |h| dist2(h.closest.point, p).sqrt())
     }
 }

@@ -137,7 +137,21 @@ impl Bvh {
     /// `hint` (a triangle index, typically the previous answer of a nearby query)
     /// seeds the search bound; it changes the time, never the answer. An
     /// out-of-range hint is ignored. Expected O(log F); O(F) worst case.
+    #[inline]
     pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Option<ClosestHit> {
+        self.closest_filtered(p, hint, |_| true)
+    }
+
+    /// [`Bvh::closest`] among the triangles accepted by `keep` (ties to the
+    /// lowest index, so the answer depends only on `p`); the hint is used only
+    /// when accepted. `None` when nothing is accepted. Expected O(log F) when
+    /// most triangles are accepted; O(F) worst case.
+    pub fn closest_filtered(
+        &self,
+        p: [f64; 3],
+        hint: Option<u32>,
+        keep: impl Fn(u32) -> bool,
+    ) -> Option<ClosestHit> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -149,7 +163,8 @@ impl Bvh {
             dist2: f64::INFINITY,
         };
         if let Some(h) = hint {
-            if let Some(&slot) = self.triangle_prim.get(h as usize) {
+            // In range first: `keep` may index by triangle.
+            if let Some(&slot) = self.triangle_prim.get(h as usize).filter(|_| keep(h)) {
                 let c = &self.prim_corners[slot as usize];
                 best_cp = closest_point_triangle(p, c[0], c[1], c[2]);
                 best_d2 = best_cp.dist2;
@@ -160,7 +175,7 @@ impl Bvh {
         let mut sp = 0usize;
         let mut node = 0usize;
         if self.nodes[0].bbox.distance2(&p) > best_d2 {
-            return Some(ClosestHit {
+            return (best_tri != u32::MAX).then_some(ClosestHit {
                 triangle: best_tri,
                 closest: best_cp,
             });
@@ -170,9 +185,12 @@ impl Bvh {
             if n.is_leaf() {
                 let s = n.start as usize;
                 for slot in s..s + n.count as usize {
+                    let tri = self.prim_triangle[slot];
+                    if !keep(tri) {
+                        continue;
+                    }
                     let c = &self.prim_corners[slot];
                     let cp = closest_point_triangle(p, c[0], c[1], c[2]);
-                    let tri = self.prim_triangle[slot];
                     if cp.dist2 < best_d2 || (cp.dist2 == best_d2 && tri < best_tri) {
                         best_d2 = cp.dist2;
                         best_tri = tri;
@@ -212,7 +230,7 @@ impl Bvh {
                 None => break,
             }
         }
-        Some(ClosestHit {
+        (best_tri != u32::MAX).then_some(ClosestHit {
             triangle: best_tri,
             closest: best_cp,
         })
