@@ -46,6 +46,7 @@ pub mod mesh;
 pub mod query;
 pub mod remesh;
 pub mod sampling;
+pub mod simplify;
 pub mod sizing;
 pub mod spatial;
 

@@ -24,7 +24,7 @@
 
 mod field;
 mod locked;
-mod ops;
+pub(crate) mod ops;
 pub mod quality;
 pub mod reference;
 mod smooth;

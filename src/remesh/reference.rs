@@ -6,7 +6,7 @@ use super::field::SourceField;
 use crate::geometry::{dist2, dot, norm, sub};
 use crate::mesh::halfedge::{HalfedgeMesh, E_FEATURE, NONE, V_CORNER, V_FEATURE};
 use crate::mesh::Grid;
-use crate::spatial::Bvh;
+use crate::spatial::{Bvh, ClosestHit};
 
 /// Feature segments of the input, grouped in lines, with a BVH over them
 /// (each segment stored as a degenerate triangle `[a, b, b]`).
@@ -16,7 +16,19 @@ pub struct FeatureLines {
     pub seg_line: Vec<u32>,
     /// Number of lines.
     pub line_count: u32,
+    /// The mesh vertices each segment joined when the lines were collected.
+    pub seg_vertices: Vec<[u32; 2]>,
     bvh: Bvh,
+}
+
+impl FeatureLines {
+    /// Closest point of `p` on line `line` (the segment index is the hit's
+    /// `triangle`; its `bary[0]` weighs the segment's first end). O(log S)
+    /// typically, with `hint` a segment near `p`.
+    pub fn closest(&self, p: [f64; 3], line: u32, hint: u32) -> Option<ClosestHit> {
+        self.bvh
+            .closest_filtered(p, Some(hint), |s| self.seg_line[s as usize] == line)
+    }
 }
 
 /// Marks corners where a feature line turns by more than `corner_deg`, then
@@ -83,6 +95,7 @@ pub fn feature_lines(mesh: &mut HalfedgeMesh, corner_deg: f64) -> (FeatureLines,
     let mut pts = Vec::new();
     let mut tris = Vec::new();
     let mut seg_line = Vec::new();
+    let mut seg_vertices = Vec::new();
     for e in 0..ne as u32 {
         if mesh.edge_flags[e as usize] & E_FEATURE == 0 {
             continue;
@@ -93,12 +106,14 @@ pub fn feature_lines(mesh: &mut HalfedgeMesh, corner_deg: f64) -> (FeatureLines,
         pts.push(mesh.positions[b as usize]);
         tris.push([i, i + 1, i + 1]);
         seg_line.push(mesh.edge_line[e as usize]);
+        seg_vertices.push([a, b]);
     }
     let bvh = Bvh::build(&pts, &tris);
     (
         FeatureLines {
             seg_line,
             line_count: lines,
+            seg_vertices,
             bvh,
         },
         turned,

@@ -17,11 +17,29 @@ pub struct Lbo {
 
 /// Computes the LBO of `h` (one value per vertex) on `grid`. O(F).
 pub fn lbo(grid: &Grid, h: &[f64]) -> Lbo {
-    let v = grid.vertices();
+    let vertex = vertex_lbo(grid.vertices(), grid.triangles().iter().copied(), h);
+    let edge = grid
+        .topology()
+        .edges
+        .iter()
+        .map(|e| 0.5 * (vertex[e[0] as usize] + vertex[e[1] as usize]))
+        .collect();
+    Lbo { vertex, edge }
+}
+
+/// Per-vertex LBO of `h` over the given triangles of the vertices `v` (one
+/// value per vertex slot; 0 for a vertex without faces). Sums in triangle
+/// order, so the result is deterministic. O(F).
+pub fn vertex_lbo(
+    v: &[[f64; 3]],
+    triangles: impl Iterator<Item = [u32; 3]>,
+    h: &[f64],
+) -> Vec<f64> {
     let nv = v.len();
     let mut sum = vec![0.0f64; nv];
     let mut area = vec![0.0f64; nv];
-    for t in grid.triangles() {
+    for t in triangles {
+        let t = &t;
         let p = t.map(|i| v[i as usize]);
         let a2 = norm(triangle_normal2(p[0], p[1], p[2]));
         if a2 <= 0.0 {
@@ -68,7 +86,7 @@ pub fn lbo(grid: &Grid, h: &[f64]) -> Lbo {
             }
         }
     }
-    let vertex: Vec<f64> = (0..nv)
+    (0..nv)
         .map(|i| {
             if area[i] > 0.0 {
                 sum[i].abs() / area[i]
@@ -76,14 +94,7 @@ pub fn lbo(grid: &Grid, h: &[f64]) -> Lbo {
                 0.0
             }
         })
-        .collect();
-    let edge = grid
-        .topology()
-        .edges
-        .iter()
-        .map(|e| 0.5 * (vertex[e[0] as usize] + vertex[e[1] as usize]))
-        .collect();
-    Lbo { vertex, edge }
+        .collect()
 }
 
 #[cfg(test)]

@@ -1,0 +1,435 @@
+//! Accurate estimation of one edge collapse (DESIGN §3.5 step 3): the virtual
+//! collapse is the real one. Placement, validity checks and the sampled size
+//! and distance errors of the triangles the collapse would make, reduced to
+//! the unit-free score `y`. Read-only on the mesh, so candidates are
+//! estimated in parallel.
+
+use super::target::Target;
+use crate::geometry::{add, closest_point_triangle, cross, dot, lerp, norm, scale, sub};
+use crate::mesh::halfedge::{
+    HalfedgeMesh, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED,
+};
+use crate::remesh::ops::reliable_normal;
+
+/// The thresholds of one estimation.
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    /// Largest size ratio allowed (`T_size`, > 1).
+    pub t_size: f64,
+    /// Largest distance to the target, as a fraction of `h_loc` (`τ_d`).
+    pub tau_d: f64,
+    /// Largest distance to the target in model units (∞ when unset).
+    pub max_distance: f64,
+    /// Cosine of the largest turn of a face normal.
+    pub cos_turn: f64,
+    /// Largest angle (degrees) a new triangle may have, unless the triangle
+    /// it replaces already had a larger one.
+    pub max_angle_deg: f64,
+}
+
+/// The estimate of one edge collapse.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimate {
+    /// The collapse is topologically and geometrically allowed.
+    pub valid: bool,
+    /// Largest size ratio `max(s_data/s_target, s_target/s_data)` over the samples (NaN when invalid).
+    pub ds: f64,
+    /// Largest distance to the target over the samples (NaN when invalid).
+    pub dd: f64,
+    /// Smaller target size at the two ends.
+    pub h_loc: f64,
+    /// Score in [0, 1]; `< 0.5` ⇔ collapsible.
+    pub y: f64,
+    /// Half-edge to collapse (its origin is removed).
+    pub halfedge: u32,
+    /// Position of the kept vertex.
+    pub position: [f64; 3],
+    /// Size of the kept vertex there.
+    pub size: f64,
+    /// Target triangle near the kept vertex (its next hint).
+    pub hint: u32,
+}
+
+impl Estimate {
+    /// An invalid collapse (score 1).
+    pub fn invalid(h_loc: f64) -> Estimate {
+        Estimate {
+            valid: false,
+            ds: f64::NAN,
+            dd: f64::NAN,
+            h_loc,
+            y: 1.0,
+            halfedge: NONE,
+            position: [f64::NAN; 3],
+            size: f64::NAN,
+            hint: NONE,
+        }
+    }
+
+    /// `y < 0.5`: the collapse keeps sizes within `T_size` and the surface
+    /// within the distance envelope.
+    pub fn collapsible(&self) -> bool {
+        self.valid && self.y < 0.5
+    }
+}
+
+/// The unit-free score `y = min(1, ½·max((Δs−1)/(T−1), Δd/(τ_d·h_loc), Δd/max_distance))`.
+pub fn score(ds: f64, dd: f64, h_loc: f64, lim: &Limits) -> f64 {
+    let a = (ds - 1.0) / (lim.t_size - 1.0);
+    let b = dd / (lim.tau_d * h_loc);
+    let c = if lim.max_distance.is_finite() {
+        dd / lim.max_distance
+    } else {
+        0.0
+    };
+    let y = 0.5 * a.max(b).max(c);
+    if y.is_nan() {
+        1.0
+    } else {
+        y.clamp(0.0, 1.0)
+    }
+}
+
+/// One triangle to sample: corners, sizes at the corners, and its patch.
+#[derive(Debug, Clone, Copy)]
+pub struct FanTri {
+    /// Corner positions.
+    pub p: [[f64; 3]; 3],
+    /// Sizes at the corners.
+    pub h: [f64; 3],
+    /// Patch of the target it lies on.
+    pub patch: u32,
+}
+
+/// Samples the interiors of `tris` on a barycentric lattice (at least 6
+/// points per triangle, denser where the triangle is long against its
+/// sizes: `n = clamp(⌈2·L/h_min⌉, 5, 16)` divisions, so samples are at most
+/// about `h_min/2` apart) and returns
+/// `(Δs, Δd)`: the largest ratio of interpolated to target size, either way,
+/// and the largest distance to the target patch. Stops as soon as the score
+/// reaches `exit_at` (the values are then lower bounds). O(samples · log F).
+pub fn sample_fan(
+    target: &Target,
+    tris: &[FanTri],
+    h_loc: f64,
+    lim: &Limits,
+    exit_at: f64,
+    hint: &mut u32,
+) -> (f64, f64) {
+    let mut ds: f64 = 1.0;
+    let mut dd: f64 = 0.0;
+    for t in tris {
+        let longest = (0..3)
+            .map(|k| norm(sub(t.p[k], t.p[(k + 1) % 3])))
+            .fold(0.0, f64::max);
+        let h_min = t.h[0].min(t.h[1]).min(t.h[2]);
+        let n = if h_min > 0.0 && longest.is_finite() {
+            (2.0 * longest / h_min).ceil().clamp(5.0, 16.0) as usize
+        } else {
+            5
+        };
+        let inv = 1.0 / n as f64;
+        for i in 1..n {
+            for j in 1..n - i {
+                let k = n - i - j;
+                let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
+                let p = add(add(scale(t.p[0], a), scale(t.p[1], b)), scale(t.p[2], c));
+                let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
+                let Some(hit) = target.on_patch(p, t.patch, *hint) else {
+                    return (f64::INFINITY, f64::INFINITY);
+                };
+                *hint = hit.index;
+                let r = if s_data > 0.0 && hit.size > 0.0 {
+                    (s_data / hit.size).max(hit.size / s_data)
+                } else {
+                    f64::INFINITY
+                };
+                ds = ds.max(r);
+                dd = dd.max(hit.dist);
+            }
+        }
+        if score(ds, dd, h_loc, lim) >= exit_at {
+            break;
+        }
+    }
+    (ds, dd)
+}
+
+fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
+    let l = norm(n);
+    (l > 0.0 && l.is_finite()).then(|| scale(n, 1.0 / l))
+}
+
+/// Largest interior angle of a triangle, degrees.
+pub fn max_angle_deg(p: [[f64; 3]; 3]) -> f64 {
+    let t = crate::geometry::triangle_angles_deg(p[0], p[1], p[2]);
+    t[0].max(t[1]).max(t[2])
+}
+
+/// Checks a face that moves from corners `old` to `new`: non-degenerate, its
+/// normal within the turn limit of the old one (or of `fallback` where the
+/// old one is noise), and no largest angle above the limit unless it was
+/// already there.
+pub fn face_ok(old: [[f64; 3]; 3], new: [[f64; 3]; 3], fallback: [f64; 3], lim: &Limits) -> bool {
+    let Some(n_new) = unit(cross(sub(new[1], new[0]), sub(new[2], new[0]))) else {
+        return false;
+    };
+    if reliable_normal(new[0], new[1], new[2]).is_none() {
+        return false;
+    }
+    let n_old = reliable_normal(old[0], old[1], old[2]).or_else(|| unit(fallback));
+    if let Some(n_old) = n_old {
+        if dot(n_new, n_old) < lim.cos_turn {
+            return false;
+        }
+    }
+    let m = max_angle_deg(new);
+    m <= lim.max_angle_deg || m <= max_angle_deg(old)
+}
+
+fn is_fixed(mesh: &HalfedgeMesh, v: u32) -> bool {
+    mesh.vertex_flags[v as usize] & (V_CORNER | V_LOCKED) != 0
+}
+
+fn on_feature(mesh: &HalfedgeMesh, v: u32) -> bool {
+    mesh.vertex_flags[v as usize] & V_FEATURE != 0 || is_fixed(mesh, v)
+}
+
+/// Estimates the collapse of edge `e` with DESIGN §3.5's placement: both ends
+/// free → the midpoint projected onto the target patch; one end on a feature
+/// (or fixed) → that end; both on features → only along a feature edge (one
+/// line), to the fixed end if one is, else to whichever end scores better.
+/// Corners and locked vertices never move. Sampling stops once the score
+/// reaches `exit_at` (use ∞ for exact Δs and Δd). O(valence² + samples · log F).
+pub fn estimate(
+    mesh: &HalfedgeMesh,
+    target: &Target,
+    e: u32,
+    lim: &Limits,
+    exit_at: f64,
+) -> Estimate {
+    let [a, b] = mesh.edge_vertices(e);
+    let h_loc = mesh.vertex_size[a as usize].min(mesh.vertex_size[b as usize]);
+    if mesh.edge_deleted(e) || mesh.edge_flags[e as usize] & E_LOCKED != 0 {
+        return Estimate::invalid(h_loc);
+    }
+    // Half-edge 2e runs a → b: collapsing it removes a.
+    let (ha, hb) = (2 * e, 2 * e + 1);
+    let keep = |h: u32| {
+        let w = mesh.to_vertex(h);
+        (
+            h,
+            mesh.positions[w as usize],
+            mesh.vertex_size[w as usize],
+            mesh.vertex_hint[w as usize],
+        )
+    };
+    let options: Vec<(u32, [f64; 3], f64, u32)> = match (on_feature(mesh, a), on_feature(mesh, b)) {
+        (false, false) => {
+            let f = if mesh.face(ha) != NONE {
+                mesh.face(ha)
+            } else {
+                mesh.face(hb)
+            };
+            if f == NONE {
+                return Estimate::invalid(h_loc);
+            }
+            let mid = lerp(mesh.positions[a as usize], mesh.positions[b as usize], 0.5);
+            match target.on_patch(
+                mid,
+                mesh.face_patch[f as usize],
+                mesh.vertex_hint[b as usize],
+            ) {
+                Some(hit) => vec![(ha, hit.point, hit.size, hit.index)],
+                None => return Estimate::invalid(h_loc),
+            }
+        }
+        (false, true) => vec![keep(ha)],
+        (true, false) => vec![keep(hb)],
+        (true, true) => {
+            if mesh.edge_flags[e as usize] & E_FEATURE == 0 {
+                return Estimate::invalid(h_loc);
+            }
+            match (is_fixed(mesh, a), is_fixed(mesh, b)) {
+                (true, true) => return Estimate::invalid(h_loc),
+                (false, true) => vec![keep(ha)],
+                (true, false) => vec![keep(hb)],
+                (false, false) => vec![keep(ha), keep(hb)],
+            }
+        }
+    };
+    let mut best = Estimate::invalid(h_loc);
+    for (h, pos, size, hint) in options {
+        let est = evaluate(mesh, target, h, pos, size, hint, h_loc, lim, exit_at);
+        if est.valid && (!best.valid || est.y < best.y) {
+            best = est;
+        }
+    }
+    best
+}
+
+/// Area-weighted normal of the faces of `v` on `patch`.
+fn star_normal(mesh: &HalfedgeMesh, v: u32, patch: u32) -> [f64; 3] {
+    let mut n = [0.0; 3];
+    for f in mesh.vertex_faces(v) {
+        if mesh.face_patch[f as usize] == patch {
+            n = add(n, mesh.face_normal2(f));
+        }
+    }
+    n
+}
+
+/// The faces around `v` after moving it to `p` (skipping faces that contain
+/// `skip`, and replacing `v` by `as_vertex` in them), with validity checks.
+/// Appends to `fan`; false when a face fails [`face_ok`].
+#[allow(clippy::too_many_arguments)]
+fn moved_faces(
+    mesh: &HalfedgeMesh,
+    v: u32,
+    skip: u32,
+    p: [f64; 3],
+    size: f64,
+    lim: &Limits,
+    fan: &mut Vec<FanTri>,
+) -> bool {
+    for f in mesh.vertex_faces(v) {
+        let fv = mesh.face_vertices(f);
+        if fv.contains(&skip) {
+            continue;
+        }
+        let old = fv.map(|x| mesh.positions[x as usize]);
+        let new = fv.map(|x| {
+            if x == v {
+                p
+            } else {
+                mesh.positions[x as usize]
+            }
+        });
+        let patch = mesh.face_patch[f as usize];
+        if !face_ok(old, new, star_normal(mesh, v, patch), lim) {
+            return false;
+        }
+        fan.push(FanTri {
+            p: new,
+            h: fv.map(|x| {
+                if x == v {
+                    size
+                } else {
+                    mesh.vertex_size[x as usize]
+                }
+            }),
+            patch,
+        });
+    }
+    true
+}
+
+/// Estimates collapsing half-edge `h` (removing its origin) with the kept
+/// vertex at `pos` with size `size`.
+#[allow(clippy::too_many_arguments)]
+fn evaluate(
+    mesh: &HalfedgeMesh,
+    target: &Target,
+    h: u32,
+    pos: [f64; 3],
+    size: f64,
+    hint: u32,
+    h_loc: f64,
+    lim: &Limits,
+    exit_at: f64,
+) -> Estimate {
+    let invalid = Estimate::invalid(h_loc);
+    if !mesh.can_collapse(h) {
+        return invalid;
+    }
+    let v = mesh.from_vertex(h);
+    let w = mesh.to_vertex(h);
+    let pv = mesh.positions[v as usize];
+    let pw = mesh.positions[w as usize];
+    let w_locked = mesh.vertex_flags[w as usize] & V_LOCKED != 0;
+    let mut line_neighbour = NONE;
+    for o in mesh.outgoing(v) {
+        let u = mesh.to_vertex(o);
+        if u == w {
+            continue;
+        }
+        if w_locked && mesh.vertex_flags[u as usize] & V_LOCKED != 0 {
+            return invalid;
+        }
+        if mesh.edge_flags[mesh.edge(o) as usize] & E_FEATURE != 0 {
+            line_neighbour = u;
+        }
+    }
+    let mut fan: Vec<FanTri> = Vec::with_capacity(12);
+    // The faces of v that survive, with v replaced by w at pos.
+    for f in mesh.vertex_faces(v) {
+        let fv = mesh.face_vertices(f);
+        if fv.contains(&w) {
+            continue;
+        }
+        let old = fv.map(|x| mesh.positions[x as usize]);
+        let new = fv.map(|x| {
+            if x == v {
+                pos
+            } else {
+                mesh.positions[x as usize]
+            }
+        });
+        let patch = mesh.face_patch[f as usize];
+        if !face_ok(old, new, star_normal(mesh, v, patch), lim) {
+            return invalid;
+        }
+        fan.push(FanTri {
+            p: new,
+            h: fv.map(|x| {
+                if x == v {
+                    size
+                } else {
+                    mesh.vertex_size[x as usize]
+                }
+            }),
+            patch,
+        });
+    }
+    let moved = pos != pw;
+    if moved && !moved_faces(mesh, w, v, pos, size, lim, &mut fan) {
+        return invalid;
+    }
+    // The removed vertex (and the kept one's old place) must stay close to
+    // the new surface.
+    let mut dd: f64 = 0.0;
+    for q in [Some(pv), moved.then_some(pw)].into_iter().flatten() {
+        let d = fan
+            .iter()
+            .map(|t| closest_point_triangle(q, t.p[0], t.p[1], t.p[2]).dist2)
+            .fold(f64::INFINITY, f64::min);
+        if d.is_finite() {
+            dd = dd.max(d.sqrt());
+        }
+    }
+    if mesh.vertex_flags[v as usize] & V_FEATURE != 0 && line_neighbour != NONE {
+        let line = mesh.edge_line[mesh.edge(h) as usize];
+        if line != NONE {
+            let pu = mesh.positions[line_neighbour as usize];
+            dd = dd.max(target.chord_distance(pos, pu, line, 4));
+        }
+    }
+    let mut sample_hint = hint;
+    let (ds, dd_s) = if score(1.0, dd, h_loc, lim) >= exit_at {
+        (1.0, 0.0)
+    } else {
+        sample_fan(target, &fan, h_loc, lim, exit_at, &mut sample_hint)
+    };
+    let dd = dd.max(dd_s);
+    Estimate {
+        valid: true,
+        ds,
+        dd,
+        h_loc,
+        y: score(ds, dd, h_loc, lim),
+        halfedge: h,
+        position: pos,
+        size,
+        hint,
+    }
+}

@@ -1,0 +1,562 @@
+//! Adaptive background-grid simplification by edge collapses: LBO-ABGS
+//! (DESIGN §3.5), the procedural simplifier of the paper.
+//!
+//! The input is the *target grid*: a dense grid with its (graded) sizes. A
+//! copy is simplified in iterations; each one
+//! 1. ranks the edges by the LBO of the size field (smoothest first),
+//! 2. takes the best-ranked `2·n·|E|` edges not already known to be
+//!    non-collapsible as candidates,
+//! 3. estimates each candidate exactly as its real collapse would go
+//!    ([`estimate`]), in parallel,
+//! 4. selects the lowest scores `y < 0.5` whose closed 1-rings are pairwise
+//!    disjoint, up to `n·|E|`,
+//! 5. collapses them and repairs locally (relaxation and flips, each checked
+//!    like a collapse),
+//! 6. re-projects the sizes of moved vertices from the target,
+//!
+//! and the loop stops when nothing is selected, after `max_iterations`, or
+//! when the progress callback asks to.
+//!
+//! An estimate depends only on the closed 1-rings of the edge's two ends, so
+//! it is kept between iterations until a vertex there changes: an edge found
+//! non-collapsible is not estimated again (nor taken into the pool) until
+//! its neighbourhood changes. The result is what re-estimating every
+//! candidate every iteration would give, without the cost.
+//!
+//! Deterministic: estimates are computed in parallel but applied in a fixed
+//! order, so the output bits do not depend on the thread count.
+
+mod estimate;
+mod repair;
+mod select;
+mod target;
+
+pub use estimate::{Estimate, Limits};
+pub use target::{Hit, Target};
+
+use crate::error::{Error, Result};
+use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED, NONE, V_CORNER};
+use crate::mesh::{BuildOptions, Features, Grid};
+use crate::remesh::reference::{feature_lines, FeatureLines};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Parameters of LBO-ABGS (defaults from DESIGN §3.5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimplifyParams {
+    /// Largest share of the edges collapsed per iteration (`n`, default 0.10).
+    pub fraction: f64,
+    /// Candidate pool size as a multiple of `n·|E|` (default 2).
+    pub pool_factor: f64,
+    /// Largest size ratio a collapse may cause (`T_size`, default 1.2).
+    pub t_size: f64,
+    /// Largest distance to the target as a fraction of the local size
+    /// (`τ_d`, default 0.05).
+    pub tau_d: f64,
+    /// Largest distance to the target in model units (`None`: no limit).
+    pub max_distance: Option<f64>,
+    /// Most iterations (default 200).
+    pub max_iterations: usize,
+    /// Dihedral angle (degrees) above which an edge is a feature (default 30).
+    pub feature_angle_deg: f64,
+    /// A feature line turning by more than this (degrees) has a corner there
+    /// (default 30).
+    pub corner_angle_deg: f64,
+    /// Largest turn of a face normal a collapse, move or flip may cause
+    /// (degrees, default 60).
+    pub max_normal_turn_deg: f64,
+    /// Largest angle of a new triangle (degrees, default 150) unless the
+    /// triangle it replaces already had a larger one.
+    pub max_angle_deg: f64,
+    /// Local repair after each batch (relaxation and flips; default true).
+    pub repair: bool,
+}
+
+impl Default for SimplifyParams {
+    fn default() -> Self {
+        SimplifyParams {
+            fraction: 0.10,
+            pool_factor: 2.0,
+            t_size: 1.2,
+            tau_d: 0.05,
+            max_distance: None,
+            max_iterations: 200,
+            feature_angle_deg: 30.0,
+            corner_angle_deg: 30.0,
+            max_normal_turn_deg: 60.0,
+            max_angle_deg: 150.0,
+            repair: true,
+        }
+    }
+}
+
+impl SimplifyParams {
+    /// Errors with a message naming the first parameter out of range.
+    pub fn check(&self) -> Result<()> {
+        let within = |x: f64, lo: f64, hi: f64, what: &str| -> Result<()> {
+            if x.is_finite() && x >= lo && x <= hi {
+                Ok(())
+            } else {
+                Err(Error::InvalidArgument(format!(
+                    "{what} = {x} must be in [{lo}, {hi}]"
+                )))
+            }
+        };
+        within(self.fraction, 1e-9, 1.0, "fraction")?;
+        within(self.pool_factor, 1.0, 1e6, "pool_factor")?;
+        within(self.t_size, 1.0 + 1e-9, 1e9, "t_size")?;
+        within(self.tau_d, 1e-12, 1e9, "tau_d")?;
+        if let Some(d) = self.max_distance {
+            within(d, f64::MIN_POSITIVE, f64::MAX, "max_distance")?;
+        }
+        within(self.feature_angle_deg, 0.0, 180.0, "feature_angle_deg")?;
+        within(self.corner_angle_deg, 0.0, 180.0, "corner_angle_deg")?;
+        within(self.max_normal_turn_deg, 0.0, 180.0, "max_normal_turn_deg")?;
+        within(self.max_angle_deg, 60.0, 180.0, "max_angle_deg")
+    }
+
+    fn limits(&self) -> Limits {
+        Limits {
+            t_size: self.t_size,
+            tau_d: self.tau_d,
+            max_distance: self.max_distance.unwrap_or(f64::INFINITY),
+            cos_turn: self.max_normal_turn_deg.to_radians().cos(),
+            max_angle_deg: self.max_angle_deg,
+        }
+    }
+}
+
+/// What one iteration did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct IterationRecord {
+    /// Iteration number (1-based).
+    pub iteration: usize,
+    /// Faces after the iteration.
+    pub faces: usize,
+    /// Vertices after the iteration.
+    pub vertices: usize,
+    /// Candidates in the pool.
+    pub candidates: usize,
+    /// Candidates estimated afresh (the others were known from earlier
+    /// iterations and their neighbourhoods had not changed).
+    pub estimated: usize,
+    /// Candidates found collapsible (`y < 0.5`).
+    pub collapsible: usize,
+    /// Collapses done.
+    pub accepted: usize,
+    /// Vertices moved by relaxation.
+    pub moved: usize,
+    /// Edges flipped.
+    pub flips: usize,
+    /// `(4/√3)∫h⁻²dA` over the grid's own surface with its own sizes: the
+    /// element count its field asks for (cheap; the metrics module measures
+    /// the official one over the dense surface).
+    pub element_count: f64,
+    /// Seconds spent.
+    pub seconds: f64,
+}
+
+/// Why the loop stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StopReason {
+    /// Nothing could be selected.
+    #[default]
+    Converged,
+    /// `max_iterations` reached.
+    MaxIterations,
+    /// The progress callback asked to stop (the grid is valid).
+    Cancelled,
+}
+
+/// What a simplification did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SimplifyReport {
+    /// Faces of the target.
+    pub faces_in: usize,
+    /// Vertices of the target.
+    pub vertices_in: usize,
+    /// Faces of the result.
+    pub faces_out: usize,
+    /// Vertices of the result.
+    pub vertices_out: usize,
+    /// Feature lines of the target.
+    pub feature_lines: usize,
+    /// Corners (never moved).
+    pub corners: usize,
+    /// Element count of the target's own field (as [`IterationRecord::element_count`]).
+    pub element_count_in: f64,
+    /// One record per iteration.
+    pub iterations: Vec<IterationRecord>,
+    /// Why it stopped.
+    pub stop: StopReason,
+    /// Seconds in all.
+    pub seconds: f64,
+}
+
+/// A simplified grid with its report.
+#[derive(Debug, Clone)]
+pub struct Simplified {
+    /// The simplified grid, with sizes.
+    pub grid: Grid,
+    /// What was done.
+    pub report: SimplifyReport,
+}
+
+/// The per-edge estimate of the first iteration: the training label of the
+/// learned simplifier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeScore {
+    /// The edge's two grid vertices.
+    pub vertices: [u32; 2],
+    /// `Δs` (NaN when invalid).
+    pub ds: f64,
+    /// `Δd / h_loc` (NaN when invalid).
+    pub dd_rel: f64,
+    /// The collapse passes the topological and geometric checks.
+    pub valid: bool,
+    /// The score `y` (1 when invalid).
+    pub y: f64,
+}
+
+/// The half-edge mesh of a target grid with its features and lines.
+struct Setup {
+    features: Features,
+    mesh: HalfedgeMesh,
+    lines: FeatureLines,
+    seg_sizes: Vec<[f64; 2]>,
+}
+
+fn setup(grid: &Grid, params: &SimplifyParams) -> Result<Setup> {
+    params.check()?;
+    let Some(sizes) = grid.sizes() else {
+        return Err(Error::InvalidArgument(
+            "the grid has no sizes (compute or set them first)".into(),
+        ));
+    };
+    let features = Features::detect(grid, params.feature_angle_deg);
+    let (mut mesh, _) = HalfedgeMesh::from_grid(grid, Some(&features));
+    for v in 0..mesh.n_vertices() {
+        let o = mesh.vertex_origin[v];
+        mesh.vertex_size[v] = if o == NONE { 0.0 } else { sizes[o as usize] };
+    }
+    let (lines, _) = feature_lines(&mut mesh, params.corner_angle_deg);
+    let seg_sizes = lines
+        .seg_vertices
+        .iter()
+        .map(|s| s.map(|v| mesh.vertex_size[v as usize]))
+        .collect();
+    Ok(Setup {
+        features,
+        mesh,
+        lines,
+        seg_sizes,
+    })
+}
+
+/// `(4/√3)∫h⁻²dA` over the live faces with linearly interpolated sizes
+/// (7-point degree-5 rule), summed in face order. O(F).
+fn own_element_count(mesh: &HalfedgeMesh) -> f64 {
+    const RULE: [(f64, f64, f64); 3] = [
+        (1.0 / 3.0, 1.0 / 3.0, 0.225),
+        (
+            0.059_715_871_789_770,
+            0.470_142_064_105_115,
+            0.132_394_152_788_506,
+        ),
+        (
+            0.797_426_985_353_087,
+            0.101_286_507_323_456,
+            0.125_939_180_544_827,
+        ),
+    ];
+    let mut total = 0.0;
+    for f in mesh.faces() {
+        let vs = mesh.face_vertices(f);
+        let h = vs.map(|v| mesh.vertex_size[v as usize]);
+        let area = 0.5 * crate::geometry::norm(mesh.face_normal2(f));
+        let mut integral = 0.0;
+        for (k, &(a, b, w)) in RULE.iter().enumerate() {
+            let points: &[[f64; 3]] = if k == 0 {
+                &[[a, a, a]]
+            } else {
+                &[[a, b, b], [b, a, b], [b, b, a]]
+            };
+            for p in points {
+                let s = p[0] * h[0] + p[1] * h[1] + p[2] * h[2];
+                integral += w / (s * s);
+            }
+        }
+        total += area * integral;
+    }
+    total * 4.0 / 3f64.sqrt()
+}
+
+/// Simplifies the target grid `grid` (which must carry sizes) by LBO-ABGS.
+/// `progress` is called after every iteration; returning `false` stops the
+/// loop, leaving a valid grid. Errors on invalid parameters or a grid
+/// without sizes. About O(I · (E log E + C · S log F)) for I iterations,
+/// C candidates estimated afresh and S samples per estimate.
+pub fn simplify(
+    grid: &Grid,
+    params: &SimplifyParams,
+    mut progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
+) -> Result<Simplified> {
+    let start = Instant::now();
+    let Setup {
+        features,
+        mut mesh,
+        lines,
+        seg_sizes,
+    } = setup(grid, params)?;
+    let target = Target {
+        grid,
+        sizes: grid.sizes().unwrap_or(&[]),
+        face_patch: &features.face_patch,
+        lines: &lines,
+        seg_sizes,
+    };
+    let lim = params.limits();
+    let flip_lim = repair::flip_limits(&lim, params.feature_angle_deg);
+    let mut report = SimplifyReport {
+        faces_in: grid.triangles().len(),
+        vertices_in: grid.vertices().len(),
+        feature_lines: lines.line_count as usize,
+        corners: mesh
+            .vertices()
+            .filter(|&v| mesh.vertex_flags[v as usize] & V_CORNER != 0)
+            .count(),
+        element_count_in: own_element_count(&mesh),
+        stop: StopReason::MaxIterations,
+        ..Default::default()
+    };
+    // Estimates kept between iterations, with the iteration that made them.
+    let mut cache: Vec<Option<(u32, Estimate)>> = vec![None; mesh.n_edges()];
+    let mut stamps = Stamps {
+        moved: vec![0; mesh.n_vertices()],
+        ring: vec![0; mesh.n_vertices()],
+    };
+    let mut used = vec![false; mesh.n_vertices()];
+    let mut ring = Vec::new();
+    for it in 1..=params.max_iterations as u32 {
+        let t = Instant::now();
+        let live = mesh.edge_count();
+        let lbo = select::edge_lbo(&mesh);
+        let mut order: Vec<u32> = mesh
+            .edges()
+            .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED == 0)
+            .collect();
+        order.sort_by(|&a, &b| lbo[a as usize].total_cmp(&lbo[b as usize]).then(a.cmp(&b)));
+        let pool_size = (params.pool_factor * params.fraction * live as f64).ceil() as usize;
+        let mut pool = Vec::with_capacity(pool_size);
+        let mut fresh = Vec::new();
+        for e in order {
+            if pool.len() >= pool_size {
+                break;
+            }
+            let known =
+                cache[e as usize].filter(|(made, _)| stamps.unchanged(&mesh, e, *made, &mut ring));
+            match known {
+                Some((_, est)) if !est.collapsible() => continue,
+                Some(_) => pool.push(e),
+                None => {
+                    pool.push(e);
+                    fresh.push(e);
+                }
+            }
+        }
+        let estimates: Vec<Estimate> = {
+            let m = &mesh;
+            fresh
+                .par_iter()
+                .map(|&e| estimate::estimate(m, &target, e, &lim, 0.5))
+                .collect()
+        };
+        for (&e, est) in fresh.iter().zip(estimates) {
+            cache[e as usize] = Some((it, est));
+        }
+        let mut ranked: Vec<(f64, u32)> = pool
+            .iter()
+            .filter_map(|&e| {
+                let (_, est) = cache[e as usize]?;
+                est.collapsible().then_some((est.y, e))
+            })
+            .collect();
+        ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let ranked_edges: Vec<u32> = ranked.iter().map(|x| x.1).collect();
+        let limit = ((params.fraction * live as f64).floor() as usize).max(1);
+        let chosen = select::disjoint_rings(&mesh, &ranked_edges, limit, &mut used);
+        let mut rec = IterationRecord {
+            iteration: it as usize,
+            candidates: pool.len(),
+            estimated: fresh.len(),
+            collapsible: ranked.len(),
+            ..Default::default()
+        };
+        let mut kept = Vec::with_capacity(chosen.len());
+        for e in &chosen {
+            let Some((_, est)) = cache[*e as usize] else {
+                continue;
+            };
+            let w = mesh.to_vertex(est.halfedge);
+            let moved = est.position != mesh.positions[w as usize];
+            if mesh.collapse(est.halfedge, est.position).is_err() {
+                continue;
+            }
+            mesh.vertex_size[w as usize] = est.size;
+            if est.hint != NONE {
+                mesh.vertex_hint[w as usize] = est.hint;
+            }
+            if moved {
+                stamps.moved[w as usize] = it;
+            }
+            stamps.ring[w as usize] = it;
+            for u in mesh.neighbors(w) {
+                stamps.ring[u as usize] = it;
+            }
+            kept.push(w);
+            rec.accepted += 1;
+        }
+        if params.repair && !kept.is_empty() {
+            let moved = repair::relax(&mut mesh, &target, &kept, &lim);
+            rec.moved = moved.len();
+            for &v in &moved {
+                stamps.moved[v as usize] = it;
+            }
+            let flipped = repair::flip_around(&mut mesh, &target, &kept, &lim, &flip_lim);
+            rec.flips = flipped.len() / 4;
+            for v in flipped {
+                stamps.ring[v as usize] = it;
+            }
+        }
+        rec.faces = mesh.face_count();
+        rec.vertices = mesh.vertex_count();
+        rec.element_count = own_element_count(&mesh);
+        rec.seconds = t.elapsed().as_secs_f64();
+        report.iterations.push(rec);
+        if rec.accepted == 0 {
+            report.stop = StopReason::Converged;
+            break;
+        }
+        if let Some(cb) = progress.as_mut() {
+            if !cb(&rec) {
+                report.stop = StopReason::Cancelled;
+                break;
+            }
+        }
+    }
+    let out = finish(&mesh)?;
+    report.faces_out = out.triangles().len();
+    report.vertices_out = out.vertices().len();
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok(Simplified { grid: out, report })
+}
+
+/// When each vertex last changed: `moved` (position or size) and `ring`
+/// (its set of neighbours), as iteration numbers (0 = never).
+struct Stamps {
+    moved: Vec<u32>,
+    ring: Vec<u32>,
+}
+
+impl Stamps {
+    /// Is an estimate of edge `e` made at iteration `made` still exact? It
+    /// reads the faces around the two ends (their rings, and the positions
+    /// and sizes of every vertex there) and the valence of the two apexes.
+    fn unchanged(&self, mesh: &HalfedgeMesh, e: u32, made: u32, ring: &mut Vec<u32>) -> bool {
+        let [a, b] = mesh.edge_vertices(e);
+        if self.ring[a as usize] >= made || self.ring[b as usize] >= made {
+            return false;
+        }
+        for h in [2 * e, 2 * e + 1] {
+            if mesh.face(h) != NONE && self.ring[mesh.to_vertex(mesh.next(h)) as usize] >= made {
+                return false;
+            }
+        }
+        select::closed_ring(mesh, e, ring);
+        ring.iter().all(|&v| self.moved[v as usize] < made)
+    }
+}
+
+/// The live mesh as a grid with sizes (locked copies merged back).
+fn finish(mesh: &HalfedgeMesh) -> Result<Grid> {
+    let (verts, tris, map) = mesh.to_arrays(true);
+    let mut sizes = vec![0.0; verts.len()];
+    for v in mesh.vertices() {
+        let k = map[v as usize];
+        if k != NONE {
+            sizes[k as usize] = mesh.vertex_size[v as usize];
+        }
+    }
+    Grid::from_arrays(
+        verts,
+        tris,
+        Some(sizes),
+        &BuildOptions {
+            weld_relative_tolerance: None,
+            orient: false,
+        },
+    )
+}
+
+/// Every edge's estimate on `grid` as it is (the first iteration's view, with
+/// exact `Δs` and `Δd`: no early exit), in `grid.topology().edges` order:
+/// the labels the learned simplifier is trained on. Edges that are not
+/// manifold in the grid are reported invalid. Parallel; O(E · S log F).
+pub fn edge_scores(grid: &Grid, params: &SimplifyParams) -> Result<Vec<EdgeScore>> {
+    let Setup {
+        features,
+        mesh,
+        lines,
+        seg_sizes,
+    } = setup(grid, params)?;
+    let target = Target {
+        grid,
+        sizes: grid.sizes().unwrap_or(&[]),
+        face_patch: &features.face_patch,
+        lines: &lines,
+        seg_sizes,
+    };
+    let lim = params.limits();
+    let topo = grid.topology();
+    let mut out: Vec<EdgeScore> = topo
+        .edges
+        .iter()
+        .map(|&vertices| EdgeScore {
+            vertices,
+            ds: f64::NAN,
+            dd_rel: f64::NAN,
+            valid: false,
+            y: 1.0,
+        })
+        .collect();
+    let found: Vec<Option<(usize, Estimate)>> = (0..mesh.n_edges() as u32)
+        .into_par_iter()
+        .map(|e| {
+            let [a, b] = mesh
+                .edge_vertices(e)
+                .map(|v| mesh.vertex_origin[v as usize]);
+            if a == NONE || b == NONE {
+                return None;
+            }
+            let k = topo.find_edge(a, b)?;
+            if topo.faces_of_edge(k).len() > 2 {
+                return None;
+            }
+            Some((
+                k,
+                estimate::estimate(&mesh, &target, e, &lim, f64::INFINITY),
+            ))
+        })
+        .collect();
+    for (k, est) in found.into_iter().flatten() {
+        let s = &mut out[k];
+        s.valid = est.valid;
+        s.y = est.y;
+        if est.valid {
+            s.ds = est.ds;
+            s.dd_rel = est.dd / est.h_loc;
+        }
+    }
+    Ok(out)
+}
+

@@ -1,0 +1,92 @@
+//! The target grid a simplification must stay faithful to: the dense grid with
+//! its smoothed sizes, its smooth patches and its feature lines. Every
+//! projection is exact (closest point through a BVH) and restricted to the
+//! patch or line the projected point belongs to, so a thin wall or a narrow
+//! gap never mixes sizes or geometry of its two sides.
+
+use crate::geometry::lerp;
+use crate::mesh::Grid;
+use crate::remesh::reference::FeatureLines;
+
+/// Where a point lands on the target.
+#[derive(Debug, Clone, Copy)]
+pub struct Hit {
+    /// The closest point.
+    pub point: [f64; 3],
+    /// The target triangle (patch projection) or feature segment (line
+    /// projection) found: the next hint.
+    pub index: u32,
+    /// Distance from the query point.
+    pub dist: f64,
+    /// Target size at the closest point (barycentric interpolation).
+    pub size: f64,
+}
+
+/// The target grid with its patches and feature lines.
+pub struct Target<'a> {
+    /// The dense grid (with sizes).
+    pub grid: &'a Grid,
+    /// Its sizes.
+    pub sizes: &'a [f64],
+    /// Smooth patch of each target triangle.
+    pub face_patch: &'a [u32],
+    /// Feature lines of the target (segments are target edges).
+    pub lines: &'a FeatureLines,
+    /// Target sizes at the two ends of each line segment.
+    pub seg_sizes: Vec<[f64; 2]>,
+}
+
+impl Target<'_> {
+    /// Closest point of `p` on patch `patch` (anywhere on the target when the
+    /// patch is empty), starting from triangle `hint`. O(log F) typically.
+    pub fn on_patch(&self, p: [f64; 3], patch: u32, hint: u32) -> Option<Hit> {
+        let bvh = self.grid.bvh();
+        let hint = (hint != u32::MAX).then_some(hint);
+        let hit = bvh
+            .closest_filtered(p, hint, |t| self.face_patch[t as usize] == patch)
+            .or_else(|| bvh.closest(p, None))?;
+        let t = self.grid.triangles()[hit.triangle as usize];
+        let b = hit.closest.bary;
+        let size = b[0] * self.sizes[t[0] as usize]
+            + b[1] * self.sizes[t[1] as usize]
+            + b[2] * self.sizes[t[2] as usize];
+        Some(Hit {
+            point: hit.closest.point,
+            index: hit.triangle,
+            dist: hit.closest.dist2.sqrt(),
+            size,
+        })
+    }
+
+    /// Closest point of `p` on feature line `line`. O(log S) typically.
+    pub fn on_line(&self, p: [f64; 3], line: u32, hint: u32) -> Option<Hit> {
+        let hint = if hint == u32::MAX { 0 } else { hint };
+        let hit = self.lines.closest(p, line, hint)?;
+        let s = self.seg_sizes[hit.triangle as usize];
+        let size = hit.closest.bary[0] * s[0] + (1.0 - hit.closest.bary[0]) * s[1];
+        Some(Hit {
+            point: hit.closest.point,
+            index: hit.triangle,
+            dist: hit.closest.dist2.sqrt(),
+            size,
+        })
+    }
+
+    /// Largest distance from points spread along segment `a`–`b` (both ends
+    /// included, `n` intervals) to line `line`.
+    pub fn chord_distance(&self, a: [f64; 3], b: [f64; 3], line: u32, n: usize) -> f64 {
+        let mut worst: f64 = 0.0;
+        let mut hint = u32::MAX;
+        for k in 0..=n {
+            let p = lerp(a, b, k as f64 / n as f64);
+            match self.on_line(p, line, hint) {
+                Some(h) => {
+                    worst = worst.max(h.dist);
+                    hint = h.index;
+                }
+                None => return f64::INFINITY,
+            }
+        }
+        worst
+    }
+}
