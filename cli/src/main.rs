@@ -11,6 +11,8 @@ mod info;
 mod points;
 mod progress;
 mod query;
+#[allow(dead_code)] // Used by `abgs run` (to come).
+mod render;
 mod size;
 
 use clap::{Parser, Subcommand, ValueEnum};
