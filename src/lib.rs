@@ -15,6 +15,7 @@
 //! - [`query`]: surface, hinted, batch and volume size queries.
 //! - [`sampling`]: deterministic point sets on and around a grid.
 //! - [`sizing`]: curvature, proximity, sources, gradation and LBO of the size field.
+//! - [`qem`]: plain quadric-error decimation (the baseline simplifier).
 //! - [`ffi`]: the C ABI.
 //!
 //! ```
@@ -43,6 +44,7 @@ pub mod ffi;
 pub mod geometry;
 pub mod io;
 pub mod mesh;
+pub mod qem;
 pub mod query;
 pub mod remesh;
 pub mod sampling;
