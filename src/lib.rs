@@ -14,6 +14,8 @@
 //! - [`spatial`]: the bounding-volume hierarchy over triangles.
 //! - [`query`]: surface, hinted, batch and volume size queries.
 //! - [`sampling`]: deterministic point sets on and around a grid.
+//! - [`metrics`]: a simplified grid against its dense reference (reduction, size
+//!   deviation, Hausdorff, estimated element count, angles).
 //! - [`sizing`]: curvature, proximity, sources, gradation and LBO of the size field.
 //! - [`ffi`]: the C ABI.
 //!
@@ -43,6 +45,7 @@ pub mod ffi;
 pub mod geometry;
 pub mod io;
 pub mod mesh;
+pub mod metrics;
 pub mod query;
 pub mod remesh;
 pub mod sampling;
