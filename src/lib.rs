@@ -14,7 +14,10 @@
 //! - [`spatial`]: the bounding-volume hierarchy over triangles.
 //! - [`query`]: surface, hinted, batch and volume size queries.
 //! - [`sampling`]: deterministic point sets on and around a grid.
+//! - [`metrics`]: a simplified grid against its dense reference (reduction, size
+//!   deviation, Hausdorff, estimated element count, angles).
 //! - [`sizing`]: curvature, proximity, sources, gradation and LBO of the size field.
+//! - [`simplify`]: LBO-ABGS, the sizing-aware simplifier (edge collapses).
 //! - [`qem`]: plain quadric-error decimation (the baseline simplifier).
 //! - [`ffi`]: the C ABI.
 //!
@@ -44,6 +47,7 @@ pub mod ffi;
 pub mod geometry;
 pub mod io;
 pub mod mesh;
+pub mod metrics;
 pub mod qem;
 pub mod query;
 pub mod remesh;

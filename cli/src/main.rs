@@ -1,11 +1,12 @@
 //! `abgs`: command-line front end of the abgs library.
 //!
 //! Subcommands: `info`, `convert`, `query`, `bench-query`, `size`,
-//! `check-gradation`, `grid`. Run `abgs --help`.
+//! `check-gradation`, `grid`, `eval`. Run `abgs --help`.
 
 #![allow(clippy::needless_range_loop)]
 
 mod bench;
+mod eval;
 mod grid;
 mod info;
 mod points;
@@ -121,6 +122,12 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Compare a simplified grid with the dense grid it came from: reduction, size
+    /// deviation, Hausdorff distance, estimated element count, angles.
+    Eval {
+        #[command(flatten)]
+        args: eval::EvalArgs,
+    },
 }
 
 fn main() -> ExitCode {
@@ -142,6 +149,7 @@ fn main() -> ExitCode {
             json,
         } => bench::run(&grid, points, seconds, json),
         Command::Size { grid, output, args } => size::run(&grid, &output, &args),
+        Command::Eval { args } => eval::run(&args),
         Command::Grid {
             input,
             output,

@@ -450,3 +450,97 @@ fn grid_check_failures_and_bad_arguments_exit_1() {
         "cannot be used with",
     );
 }
+
+#[test]
+fn eval_reports_json_and_a_table() {
+    // A sized bumpy plate (via `abgs size`) against itself and against a 2-face plate.
+    let n = 20;
+    let mut v = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            v.push([x, y, 0.05 * (6.0 * x).sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let input = tmp("eval-plate.obj");
+    abgs::Grid::from_arrays(v, t, None, &abgs::BuildOptions::default())
+        .unwrap()
+        .save(&input)
+        .unwrap();
+    let dense = tmp("eval-plate-sized.vtk");
+    let st = abgs()
+        .arg("size")
+        .arg(&input)
+        .arg("-o")
+        .arg(&dense)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let eval = |candidate: &PathBuf, json: bool| {
+        let mut c = abgs();
+        c.arg("eval")
+            .arg("--reference")
+            .arg(&dense)
+            .arg("--candidate")
+            .arg(candidate)
+            .args(["--samples", "5000", "--hausdorff-samples", "5000"]);
+        if json {
+            c.arg("--json");
+        }
+        c.output().unwrap()
+    };
+    let out = eval(&dense, true);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["faces_reference"], 800);
+    assert_eq!(v["faces_candidate"], 800);
+    assert_eq!(v["reduction"], 0.0);
+    assert_eq!(v["size_deviation"]["mean"], 1.0);
+    assert_eq!(v["size_deviation"]["max"], 1.0);
+    assert_eq!(v["size_deviation"]["samples"], 5000);
+    assert!(v["element_count_change"].as_f64().unwrap().abs() < 1e-12);
+    assert!(v["hausdorff_relative"].as_f64().unwrap() < 1e-12);
+    assert!(v["angles_candidate"]["min_p5"].as_f64().unwrap() > 40.0);
+    assert!(v["reference"]
+        .as_str()
+        .unwrap()
+        .ends_with("eval-plate-sized.vtk"));
+    // A 2-face flat candidate: reduction, deviation and distance are reported.
+    let coarse = sized_grid("eval");
+    let out = eval(&coarse, true);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["reduction"], 1.0 - 2.0 / 800.0);
+    assert!(v["size_deviation"]["max"].as_f64().unwrap() > 1.0);
+    assert!(v["hausdorff"].as_f64().unwrap() > 0.04);
+    let text = eval(&coarse, false);
+    let s = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.status.success() && s.contains("size deviation") && s.contains("element count"),
+        "{s}"
+    );
+    // A candidate without sizes fails with a message.
+    let out = eval(&input, false);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no sizes"));
+}

@@ -7,7 +7,6 @@ use crate::error::Result;
 use crate::geometry::{dist2, lerp};
 use crate::mesh::features::{BOUNDARY, NON_MANIFOLD};
 use crate::mesh::{Features, Grid};
-use crate::sampling::surface_points;
 use crate::spatial::Bvh;
 use rayon::prelude::*;
 
@@ -115,32 +114,8 @@ fn two_way(a: &Segments, b: &Segments, n: usize) -> f64 {
     d1.max(d2)
 }
 
-/// Symmetric Hausdorff distance between two surfaces, from `n` area-uniform
-/// samples on each (plus every vertex), measured exactly through each
-/// grid's BVH. O((n + V) log F).
-pub fn hausdorff(a: &Grid, b: &Grid, n: usize, seed: u64) -> f64 {
-    let one = |x: &Grid, y: &Grid| {
-        let mut pts: Vec<[f64; 3]> = surface_points(x, n, seed)
-            .into_iter()
-            .map(|s| s.1)
-            .collect();
-        pts.extend_from_slice(x.vertices());
-        pts.par_chunks(512)
-            .map(|c| {
-                let mut hint = None;
-                let mut m: f64 = 0.0;
-                for &p in c {
-                    if let Some(h) = y.bvh().closest(p, hint) {
-                        m = m.max(h.closest.dist2.sqrt());
-                        hint = Some(h.triangle);
-                    }
-                }
-                m
-            })
-            .reduce(|| 0.0, f64::max)
-    };
-    one(a, b).max(one(b, a))
-}
+/// Symmetric sampled Hausdorff distance (moved to [`crate::metrics`]).
+pub use crate::metrics::hausdorff;
 
 /// Per unique edge of `grid`: its length over the target `h` at its midpoint
 /// (`h(point, hint)`, hinted per chunk); returns the mean and the share in
