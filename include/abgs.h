@@ -72,6 +72,24 @@ typedef enum {
   ABGS_ERR_INTERNAL = 99,
 } abgs_status;
 
+// Simplification method.
+typedef enum {
+  // LBO-ABGS, the procedural simplifier (accurate estimation of every candidate).
+  ABGS_METHOD_LBO = 0,
+  // GCN-ABGS, the learned simplifier: not in this build (ABGS_ERR_NOT_AVAILABLE).
+  ABGS_METHOD_GCN = 1,
+} abgs_method;
+
+// Why a simplification stopped.
+typedef enum {
+  // Nothing could be selected any more.
+  ABGS_STOP_CONVERGED = 0,
+  // `max_iterations` reached.
+  ABGS_STOP_MAX_ITERATIONS = 1,
+  // The progress callback asked to stop; the grid is valid.
+  ABGS_STOP_CANCELLED = 2,
+} abgs_stop;
+
 // Opaque handle to a background grid. Create with `abgs_grid_from_arrays`,
 // `abgs_grid_load` or `abgs_grid_remesh`, release with `abgs_grid_free`.
 typedef struct abgs_grid abgs_grid;
@@ -185,6 +203,97 @@ typedef struct {
   // their texts come from `abgs_grid_remesh_issue`.
   uint64_t n_issues;
 } abgs_remesh_report;
+
+// What one iteration did (given to the progress callback, and readable
+// afterwards with `abgs_grid_simplify_iteration`).
+typedef struct {
+  // Iteration number, from 1.
+  uint64_t iteration;
+  // Faces after the iteration.
+  uint64_t faces;
+  // Vertices after the iteration.
+  uint64_t vertices;
+  // Candidates in the pool.
+  uint64_t candidates;
+  // Candidates estimated afresh (the rest were known and unchanged).
+  uint64_t estimated;
+  // Candidates found collapsible (y < 0.5).
+  uint64_t collapsible;
+  // Collapses done.
+  uint64_t accepted;
+  // Vertices moved by the local repair.
+  uint64_t moved;
+  // Edges flipped by the local repair.
+  uint64_t flips;
+  // (4/√3)∫h⁻²dA of the grid's own field over its own surface.
+  double element_count;
+  // Seconds.
+  double seconds;
+} abgs_iteration_record;
+
+// Called after every iteration with its record and `user_data`; return 0 to
+// go on, anything else to stop (the grid made so far is returned, valid).
+typedef int32_t (*abgs_progress_fn)(const abgs_iteration_record *record, void *user_data);
+
+// Parameters of `abgs_simplify`; get the defaults from
+// `abgs_simplify_params_default`. A NaN or infinite value gives
+// ABGS_ERR_NON_FINITE, a finite value out of range ABGS_ERR_INVALID_ARGUMENT.
+typedef struct {
+  // ABGS_METHOD_LBO (default) or ABGS_METHOD_GCN.
+  abgs_method method;
+  // Largest share of the edges collapsed per iteration, in (0, 1] (default 0.10).
+  double fraction;
+  // Candidate pool as a multiple of `fraction`·|E|, >= 1 (default 2).
+  double pool_factor;
+  // Largest size ratio a collapse may cause, > 1 (default 1.2).
+  double t_size;
+  // Largest distance to the dense grid as a fraction of the local size, > 0 (default 0.05).
+  double tau_d;
+  // Largest distance to the dense grid in model units; 0 = no limit (default 0).
+  double max_distance;
+  // Most iterations, >= 1 (default 200).
+  uint32_t max_iterations;
+  // Dihedral angle (degrees) above which an edge is a kept feature (default 30).
+  double feature_angle_deg;
+  // A feature line turning more than this (degrees) has a fixed corner (default 30).
+  double corner_angle_deg;
+  // Largest turn of a face normal, degrees (default 60).
+  double max_normal_turn_deg;
+  // Largest angle of a new triangle, degrees in [60, 180] (default 150).
+  double max_angle_deg;
+  // 1 = local repair (relaxation, flips) after each batch (default 1).
+  int32_t repair;
+  // Progress callback (NULL = none).
+  abgs_progress_fn progress;
+  // Passed to `progress` unchanged.
+  void *user_data;
+} abgs_simplify_params;
+
+// What `abgs_simplify` did.
+typedef struct {
+  // Faces of the dense grid.
+  uint64_t faces_in;
+  // Vertices of the dense grid.
+  uint64_t vertices_in;
+  // Faces of the result.
+  uint64_t faces_out;
+  // Vertices of the result.
+  uint64_t vertices_out;
+  // Iterations run (records: `abgs_grid_simplify_iteration`).
+  uint64_t iterations;
+  // Why it stopped.
+  abgs_stop stop;
+  // Feature lines of the dense grid.
+  uint64_t feature_lines;
+  // Corners (never moved).
+  uint64_t corners;
+  // (4/√3)∫h⁻²dA of the dense grid's field.
+  double element_count_in;
+  // The same for the result (its own field over its own surface).
+  double element_count_out;
+  // Seconds in all.
+  double seconds;
+} abgs_simplify_report;
 
 // A user size source: every vertex within `radius` of the shape gets at most `size`.
 typedef struct {
@@ -542,6 +651,70 @@ abgs_status abgs_grid_remesh_issue(const abgs_grid *grid,
                                    char *out_text,
                                    size_t capacity,
                                    size_t *out_len);
+
+// Writes the default parameters into `*out_params`.
+//
+// # Safety
+// `out_params` is NULL (reported) or writable.
+abgs_status abgs_simplify_params_default(abgs_simplify_params *out_params);
+
+// Simplifies the dense grid `grid` (which must carry sizes) into a new grid
+// with sizes: edge collapses chosen by accurate estimation (LBO-ABGS), each
+// keeping the interpolated size within `t_size` of the dense grid's and the
+// surface within `tau_d`·h (and `max_distance`) of it; feature lines,
+// corners, boundaries and bodies are kept. `params` NULL = the defaults.
+//
+// `progress` (if set) is called after every iteration, on the calling
+// thread; a non-zero return stops the loop and the grid made so far is
+// returned (status OK, `stop` = ABGS_STOP_CANCELLED). On success `*out_grid`
+// owns the new grid, whose handle also holds the per-iteration records
+// (`abgs_grid_simplify_iteration`); on failure it is NULL. `out_report` (may
+// be NULL) receives what was done. `grid` is only read. The result does not
+// depend on the thread count. Cost: about O(I·(E log E + C·S log F)) for I
+// iterations, C candidates estimated with S samples each (parallel).
+//
+// Errors: NULL (grid, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
+// NOT_AVAILABLE (ABGS_METHOD_GCN), NO_SIZES, BUSY (a mutation is running on `grid`).
+//
+// # Safety
+// Pointers are NULL (reported / "absent" where documented) or valid; `grid`
+// comes from this library; `progress` is safe to call with `user_data`.
+abgs_status abgs_simplify(const abgs_grid *grid,
+                          const abgs_simplify_params *params,
+                          abgs_grid **out_grid,
+                          abgs_simplify_report *out_report);
+
+// Copies the record of iteration `index` (0-based, below
+// `abgs_simplify_report.iterations`) of a grid made by `abgs_simplify` into
+// `*out_record`. Errors: NULL, OUT_OF_RANGE (index, or a grid not made by
+// `abgs_simplify`, which has no records).
+//
+// # Safety
+// Pointers are NULL (reported) or valid.
+abgs_status abgs_grid_simplify_iteration(const abgs_grid *grid,
+                                         size_t index,
+                                         abgs_iteration_record *out_record);
+
+// Every edge's collapse estimate on `grid` as it is (the first iteration's
+// view, exact Δs and Δd), in the order of `abgs_grid_copy_edges`: `out_ds`
+// (Δs), `out_dd` (Δd / h_loc), `out_valid` (1 = the collapse passes the
+// topological and geometric checks) and `out_y` (the score in [0, 1];
+// < 0.5 = collapsible; 1 when invalid). Invalid edges get NaN in `out_ds` and
+// `out_dd`. Each buffer holds `capacity` >= the edge count
+// (`abgs_grid_stats.edges`) elements (`abgs_grid_edge_count`), else BUFFER_TOO_SMALL; any of the four
+// may be NULL to skip it. `params` NULL = defaults (only the thresholds and
+// angles are used). Parallel; the result does not depend on the thread count.
+// Errors: NULL (grid), NON_FINITE / INVALID_ARGUMENT, NO_SIZES, BUSY.
+//
+// # Safety
+// Pointers are NULL or valid for `capacity` elements.
+abgs_status abgs_edge_scores(const abgs_grid *grid,
+                             const abgs_simplify_params *params,
+                             double *out_ds,
+                             double *out_dd,
+                             uint8_t *out_valid,
+                             double *out_y,
+                             size_t capacity);
 
 // Writes the default parameters into `*out_params`.
 //

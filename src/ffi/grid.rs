@@ -14,6 +14,9 @@ pub struct abgs_grid {
     /// `None` for grids made otherwise. Never changes after creation (no call
     /// changes a grid's vertices or triangles); read it under [`abgs_grid::read`].
     remeshed: Option<RemeshInfo>,
+    /// The per-iteration records of `abgs_simplify` for a grid it made
+    /// (empty for grids made otherwise). Never changes after creation.
+    iterations: Vec<super::simplify::abgs_iteration_record>,
 }
 
 impl abgs_grid {
@@ -56,7 +59,25 @@ impl abgs_grid {
         Box::into_raw(Box::new(abgs_grid {
             lock: RwLock::new(g),
             remeshed,
+            iterations: Vec::new(),
         }))
+    }
+
+    /// A new handle owning a simplified grid and its per-iteration records.
+    pub(crate) fn boxed_simplified(
+        g: Grid,
+        iterations: Vec<super::simplify::abgs_iteration_record>,
+    ) -> *mut abgs_grid {
+        Box::into_raw(Box::new(abgs_grid {
+            lock: RwLock::new(g),
+            remeshed: None,
+            iterations,
+        }))
+    }
+
+    /// The records of the simplification that made this grid (empty otherwise).
+    pub(crate) fn iterations(&self) -> &[super::simplify::abgs_iteration_record] {
+        &self.iterations
     }
 
     /// The remesher's record, if this grid came from `abgs_grid_remesh`.

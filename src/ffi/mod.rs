@@ -17,10 +17,12 @@ mod boundary;
 mod grid;
 mod query;
 mod remesh;
+mod simplify;
 mod sizing;
 
 pub use boundary::*;
 pub use grid::*;
 pub use query::*;
 pub use remesh::*;
+pub use simplify::*;
 pub use sizing::*;

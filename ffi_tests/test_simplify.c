@@ -1,0 +1,155 @@
+/* Simplification through the C ABI: defaults, LBO-ABGS on a plate with a
+   size ramp, the report and per-iteration records, the progress callback and
+   cancelling from it, per-edge scores, and every error path. */
+#include <math.h>
+#include <stdlib.h>
+#include "check.h"
+
+#define N 40
+#define NV ((N + 1) * (N + 1))
+#define NT (2 * N * N)
+
+struct progress_state {
+    int calls;
+    int stop_after;
+    uint64_t last_faces;
+};
+
+static int32_t on_progress(const abgs_iteration_record *r, void *user) {
+    struct progress_state *s = (struct progress_state *)user;
+    s->calls++;
+    CHECK(r != NULL && r->iteration == (uint64_t)s->calls);
+    CHECK(r->faces < NT && r->accepted > 0 && r->element_count > 0.0);
+    s->last_faces = r->faces;
+    return s->stop_after > 0 && s->calls >= s->stop_after;
+}
+
+int main(void) {
+    abgs_simplify_params p;
+    CHECK_STATUS(abgs_simplify_params_default(&p), ABGS_OK);
+    CHECK(p.method == ABGS_METHOD_LBO && p.fraction == 0.10 && p.pool_factor == 2.0);
+    CHECK(p.t_size == 1.2 && p.tau_d == 0.05 && p.max_distance == 0.0);
+    CHECK(p.max_iterations == 200 && p.repair == 1 && p.progress == NULL);
+    CHECK_STATUS(abgs_simplify_params_default(NULL), ABGS_ERR_NULL);
+
+    static double xyz[3 * NV];
+    static uint32_t tris[3 * NT];
+    static double h[NV];
+    make_plate(N, xyz, tris);
+    for (int i = 0; i < NV; i++) h[i] = 0.02 + 0.2 * xyz[3 * i];
+    abgs_grid *dense = NULL, *out = NULL;
+    CHECK_STATUS(abgs_grid_from_arrays(xyz, NV, tris, NT, NULL, &dense), ABGS_OK);
+
+    /* No sizes yet. */
+    CHECK_STATUS(abgs_simplify(dense, &p, &out, NULL), ABGS_ERR_NO_SIZES);
+    CHECK(out == NULL);
+    CHECK_STATUS(abgs_grid_set_sizes(dense, h, NV), ABGS_OK);
+
+    /* Full run with a progress callback. */
+    struct progress_state st = {0, 0, 0};
+    p.progress = on_progress;
+    p.user_data = &st;
+    abgs_simplify_report r;
+    CHECK_STATUS(abgs_simplify(dense, &p, &out, &r), ABGS_OK);
+    CHECK(out != NULL);
+    CHECK(r.faces_in == NT && r.vertices_in == NV);
+    CHECK(r.faces_out < NT / 2 && r.faces_out > 2);
+    CHECK(r.stop == ABGS_STOP_CONVERGED);
+    CHECK(r.iterations >= 2 && (int)r.iterations == st.calls + 1); /* the last selected nothing */
+    CHECK(r.corners == 4 && r.feature_lines >= 4);
+    CHECK(r.element_count_in > 0.0 && fabs(r.element_count_out / r.element_count_in - 1.0) < 0.1);
+    size_t nt = 0, nv = 0;
+    CHECK_STATUS(abgs_grid_triangle_count(out, &nt), ABGS_OK);
+    CHECK_STATUS(abgs_grid_vertex_count(out, &nv), ABGS_OK);
+    CHECK(nt == r.faces_out && nv == r.vertices_out);
+    /* Sizes come with the result and follow the ramp. */
+    double q = 0.0;
+    double mid[3] = {0.5, 0.5, 0.0};
+    CHECK_STATUS(abgs_query_size(out, mid, &q), ABGS_OK);
+    CHECK(fabs(q / 0.12 - 1.0) < 0.2);
+    abgs_iteration_record rec;
+    CHECK_STATUS(abgs_grid_simplify_iteration(out, 0, &rec), ABGS_OK);
+    CHECK(rec.iteration == 1 && rec.accepted > 0 && rec.candidates >= rec.collapsible);
+    CHECK_STATUS(abgs_grid_simplify_iteration(out, (size_t)r.iterations - 1, &rec), ABGS_OK);
+    CHECK(rec.faces == r.faces_out && rec.accepted == 0);
+    CHECK_STATUS(abgs_grid_simplify_iteration(out, (size_t)r.iterations, &rec), ABGS_ERR_OUT_OF_RANGE);
+    CHECK_STATUS(abgs_grid_simplify_iteration(dense, 0, &rec), ABGS_ERR_OUT_OF_RANGE);
+    CHECK_STATUS(abgs_grid_simplify_iteration(out, 0, NULL), ABGS_ERR_NULL);
+
+    /* Cancel after two iterations: a valid, partly simplified grid. */
+    abgs_grid *part = NULL;
+    struct progress_state st2 = {0, 2, 0};
+    p.user_data = &st2;
+    CHECK_STATUS(abgs_simplify(dense, &p, &part, &r), ABGS_OK);
+    CHECK(part != NULL && r.stop == ABGS_STOP_CANCELLED && r.iterations == 2 && st2.calls == 2);
+    CHECK(r.faces_out == st2.last_faces && r.faces_out < NT && r.faces_out > nt);
+    CHECK_STATUS(abgs_query_size(part, mid, &q), ABGS_OK);
+    CHECK_STATUS(abgs_grid_free(part), ABGS_OK);
+    p.progress = NULL;
+    p.user_data = NULL;
+
+    /* NULL params = defaults: the same result. */
+    abgs_grid *again = NULL;
+    CHECK_STATUS(abgs_simplify(dense, NULL, &again, &r), ABGS_OK);
+    CHECK(r.faces_out == nt);
+    CHECK_STATUS(abgs_grid_free(again), ABGS_OK);
+
+    /* Edge scores, in the order of abgs_grid_copy_edges. */
+    size_t ne = 0;
+    CHECK_STATUS(abgs_grid_edge_count(dense, &ne), ABGS_OK);
+    double *ds = malloc(ne * sizeof *ds), *dd = malloc(ne * sizeof *dd), *y = malloc(ne * sizeof *y);
+    uint8_t *valid = malloc(ne);
+    CHECK_STATUS(abgs_edge_scores(dense, &p, ds, dd, valid, y, ne), ABGS_OK);
+    size_t n_valid = 0, n_coll = 0;
+    for (size_t e = 0; e < ne; e++) {
+        CHECK(y[e] >= 0.0 && y[e] <= 1.0);
+        if (valid[e]) {
+            n_valid++;
+            double expect = 0.5 * fmax((ds[e] - 1.0) / 0.2, dd[e] / 0.05);
+            if (expect > 1.0) expect = 1.0;
+            CHECK(fabs(expect - y[e]) < 1e-12);
+            CHECK(dd[e] < 1e-12); /* a plate: collapses stay on it */
+            if (y[e] < 0.5) n_coll++;
+        } else {
+            CHECK(y[e] == 1.0 && isnan(ds[e]) && isnan(dd[e]));
+        }
+    }
+    CHECK(n_valid > ne / 2 && n_coll > 0); /* a linear ramp on a plate: exact */
+    CHECK_STATUS(abgs_edge_scores(dense, NULL, NULL, NULL, NULL, y, ne), ABGS_OK);
+    CHECK_STATUS(abgs_edge_scores(dense, NULL, NULL, NULL, NULL, y, ne - 1), ABGS_ERR_BUFFER_TOO_SMALL);
+    CHECK_STATUS(abgs_edge_scores(NULL, NULL, NULL, NULL, NULL, y, ne), ABGS_ERR_NULL);
+
+    /* Errors. */
+    CHECK_STATUS(abgs_simplify(NULL, &p, &out, NULL), ABGS_ERR_NULL);
+    CHECK_STATUS(abgs_simplify(dense, &p, NULL, NULL), ABGS_ERR_NULL);
+    abgs_grid *none = NULL;
+    abgs_simplify_params bad = p;
+    bad.method = ABGS_METHOD_GCN;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_NOT_AVAILABLE);
+    CHECK(none == NULL);
+    bad = p;
+    bad.t_size = NAN;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_NON_FINITE);
+    bad = p;
+    bad.t_size = 1.0;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    bad = p;
+    bad.fraction = 0.0;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    bad = p;
+    bad.max_iterations = 0;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    bad = p;
+    bad.max_distance = -1.0;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK_STATUS(abgs_edge_scores(dense, &bad, NULL, NULL, NULL, y, ne), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(none == NULL);
+
+    free(ds);
+    free(dd);
+    free(y);
+    free(valid);
+    CHECK_STATUS(abgs_grid_free(out), ABGS_OK);
+    CHECK_STATUS(abgs_grid_free(dense), ABGS_OK);
+    return finish();
+}

@@ -1,0 +1,415 @@
+//! Simplification through the C ABI: parameters with defaults, LBO-ABGS into a
+//! new grid with a progress callback that can cancel, the per-iteration
+//! records, and every edge's score (the learned simplifier's labels).
+
+use super::boundary::*;
+use super::grid::{abgs_grid, checked_out};
+use crate::simplify::{self, IterationRecord, SimplifyParams, StopReason};
+use std::ffi::c_void;
+
+/// Simplification method.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum abgs_method {
+    /// LBO-ABGS, the procedural simplifier (accurate estimation of every candidate).
+    ABGS_METHOD_LBO = 0,
+    /// GCN-ABGS, the learned simplifier: not in this build (ABGS_ERR_NOT_AVAILABLE).
+    ABGS_METHOD_GCN = 1,
+}
+
+/// Why a simplification stopped.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum abgs_stop {
+    /// Nothing could be selected any more.
+    ABGS_STOP_CONVERGED = 0,
+    /// `max_iterations` reached.
+    ABGS_STOP_MAX_ITERATIONS = 1,
+    /// The progress callback asked to stop; the grid is valid.
+    ABGS_STOP_CANCELLED = 2,
+}
+
+/// What one iteration did (given to the progress callback, and readable
+/// afterwards with `abgs_grid_simplify_iteration`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct abgs_iteration_record {
+    /// Iteration number, from 1.
+    pub iteration: u64,
+    /// Faces after the iteration.
+    pub faces: u64,
+    /// Vertices after the iteration.
+    pub vertices: u64,
+    /// Candidates in the pool.
+    pub candidates: u64,
+    /// Candidates estimated afresh (the rest were known and unchanged).
+    pub estimated: u64,
+    /// Candidates found collapsible (y < 0.5).
+    pub collapsible: u64,
+    /// Collapses done.
+    pub accepted: u64,
+    /// Vertices moved by the local repair.
+    pub moved: u64,
+    /// Edges flipped by the local repair.
+    pub flips: u64,
+    /// (4/√3)∫h⁻²dA of the grid's own field over its own surface.
+    pub element_count: f64,
+    /// Seconds.
+    pub seconds: f64,
+}
+
+/// Called after every iteration with its record and `user_data`; return 0 to
+/// go on, anything else to stop (the grid made so far is returned, valid).
+pub type abgs_progress_fn =
+    Option<unsafe extern "C" fn(record: *const abgs_iteration_record, user_data: *mut c_void) -> i32>;
+
+/// Parameters of `abgs_simplify`; get the defaults from
+/// `abgs_simplify_params_default`. A NaN or infinite value gives
+/// ABGS_ERR_NON_FINITE, a finite value out of range ABGS_ERR_INVALID_ARGUMENT.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct abgs_simplify_params {
+    /// ABGS_METHOD_LBO (default) or ABGS_METHOD_GCN.
+    pub method: abgs_method,
+    /// Largest share of the edges collapsed per iteration, in (0, 1] (default 0.10).
+    pub fraction: f64,
+    /// Candidate pool as a multiple of `fraction`·|E|, >= 1 (default 2).
+    pub pool_factor: f64,
+    /// Largest size ratio a collapse may cause, > 1 (default 1.2).
+    pub t_size: f64,
+    /// Largest distance to the dense grid as a fraction of the local size, > 0 (default 0.05).
+    pub tau_d: f64,
+    /// Largest distance to the dense grid in model units; 0 = no limit (default 0).
+    pub max_distance: f64,
+    /// Most iterations, >= 1 (default 200).
+    pub max_iterations: u32,
+    /// Dihedral angle (degrees) above which an edge is a kept feature (default 30).
+    pub feature_angle_deg: f64,
+    /// A feature line turning more than this (degrees) has a fixed corner (default 30).
+    pub corner_angle_deg: f64,
+    /// Largest turn of a face normal, degrees (default 60).
+    pub max_normal_turn_deg: f64,
+    /// Largest angle of a new triangle, degrees in [60, 180] (default 150).
+    pub max_angle_deg: f64,
+    /// 1 = local repair (relaxation, flips) after each batch (default 1).
+    pub repair: i32,
+    /// Progress callback (NULL = none).
+    pub progress: abgs_progress_fn,
+    /// Passed to `progress` unchanged.
+    pub user_data: *mut c_void,
+}
+
+/// What `abgs_simplify` did.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct abgs_simplify_report {
+    /// Faces of the dense grid.
+    pub faces_in: u64,
+    /// Vertices of the dense grid.
+    pub vertices_in: u64,
+    /// Faces of the result.
+    pub faces_out: u64,
+    /// Vertices of the result.
+    pub vertices_out: u64,
+    /// Iterations run (records: `abgs_grid_simplify_iteration`).
+    pub iterations: u64,
+    /// Why it stopped.
+    pub stop: abgs_stop,
+    /// Feature lines of the dense grid.
+    pub feature_lines: u64,
+    /// Corners (never moved).
+    pub corners: u64,
+    /// (4/√3)∫h⁻²dA of the dense grid's field.
+    pub element_count_in: f64,
+    /// The same for the result (its own field over its own surface).
+    pub element_count_out: f64,
+    /// Seconds in all.
+    pub seconds: f64,
+}
+
+/// Writes the default parameters into `*out_params`.
+///
+/// # Safety
+/// `out_params` is NULL (reported) or writable.
+#[no_mangle]
+pub unsafe extern "C" fn abgs_simplify_params_default(
+    out_params: *mut abgs_simplify_params,
+) -> abgs_status {
+    guard("abgs_simplify_params_default", || {
+        // SAFETY: writable or NULL (checked).
+        let o = unsafe { out(out_params, "out_params")? };
+        let d = SimplifyParams::default();
+        *o = abgs_simplify_params {
+            method: abgs_method::ABGS_METHOD_LBO,
+            fraction: d.fraction,
+            pool_factor: d.pool_factor,
+            t_size: d.t_size,
+            tau_d: d.tau_d,
+            max_distance: 0.0,
+            max_iterations: d.max_iterations as u32,
+            feature_angle_deg: d.feature_angle_deg,
+            corner_angle_deg: d.corner_angle_deg,
+            max_normal_turn_deg: d.max_normal_turn_deg,
+            max_angle_deg: d.max_angle_deg,
+            repair: 1,
+            progress: None,
+            user_data: std::ptr::null_mut(),
+        };
+        Ok(())
+    })
+}
+
+/// Converts C parameters to Rust ones.
+fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
+    for (x, what) in [
+        (p.fraction, "fraction"),
+        (p.pool_factor, "pool_factor"),
+        (p.t_size, "t_size"),
+        (p.tau_d, "tau_d"),
+        (p.max_distance, "max_distance"),
+        (p.feature_angle_deg, "feature_angle_deg"),
+        (p.corner_angle_deg, "corner_angle_deg"),
+        (p.max_normal_turn_deg, "max_normal_turn_deg"),
+        (p.max_angle_deg, "max_angle_deg"),
+    ] {
+        if !x.is_finite() {
+            return err(
+                abgs_status::ABGS_ERR_NON_FINITE,
+                format!("{what} = {x} must be finite"),
+            );
+        }
+    }
+    if p.max_distance < 0.0 {
+        return err(
+            abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+            format!("max_distance = {} must be >= 0 (0 = no limit)", p.max_distance),
+        );
+    }
+    if p.max_iterations == 0 {
+        return err(
+            abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+            "max_iterations = 0 must be >= 1",
+        );
+    }
+    let params = SimplifyParams {
+        fraction: p.fraction,
+        pool_factor: p.pool_factor,
+        t_size: p.t_size,
+        tau_d: p.tau_d,
+        max_distance: (p.max_distance > 0.0).then_some(p.max_distance),
+        max_iterations: p.max_iterations as usize,
+        feature_angle_deg: p.feature_angle_deg,
+        corner_angle_deg: p.corner_angle_deg,
+        max_normal_turn_deg: p.max_normal_turn_deg,
+        max_angle_deg: p.max_angle_deg,
+        repair: p.repair != 0,
+    };
+    params.check()?;
+    Ok(params)
+}
+
+fn record(r: &IterationRecord) -> abgs_iteration_record {
+    abgs_iteration_record {
+        iteration: r.iteration as u64,
+        faces: r.faces as u64,
+        vertices: r.vertices as u64,
+        candidates: r.candidates as u64,
+        estimated: r.estimated as u64,
+        collapsible: r.collapsible as u64,
+        accepted: r.accepted as u64,
+        moved: r.moved as u64,
+        flips: r.flips as u64,
+        element_count: r.element_count,
+        seconds: r.seconds,
+    }
+}
+
+/// Simplifies the dense grid `grid` (which must carry sizes) into a new grid
+/// with sizes: edge collapses chosen by accurate estimation (LBO-ABGS), each
+/// keeping the interpolated size within `t_size` of the dense grid's and the
+/// surface within `tau_d`·h (and `max_distance`) of it; feature lines,
+/// corners, boundaries and bodies are kept. `params` NULL = the defaults.
+///
+/// `progress` (if set) is called after every iteration, on the calling
+/// thread; a non-zero return stops the loop and the grid made so far is
+/// returned (status OK, `stop` = ABGS_STOP_CANCELLED). On success `*out_grid`
+/// owns the new grid, whose handle also holds the per-iteration records
+/// (`abgs_grid_simplify_iteration`); on failure it is NULL. `out_report` (may
+/// be NULL) receives what was done. `grid` is only read. The result does not
+/// depend on the thread count. Cost: about O(I·(E log E + C·S log F)) for I
+/// iterations, C candidates estimated with S samples each (parallel).
+///
+/// Errors: NULL (grid, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
+/// NOT_AVAILABLE (ABGS_METHOD_GCN), NO_SIZES, BUSY (a mutation is running on `grid`).
+///
+/// # Safety
+/// Pointers are NULL (reported / "absent" where documented) or valid; `grid`
+/// comes from this library; `progress` is safe to call with `user_data`.
+#[no_mangle]
+pub unsafe extern "C" fn abgs_simplify(
+    grid: *const abgs_grid,
+    params: *const abgs_simplify_params,
+    out_grid: *mut *mut abgs_grid,
+    out_report: *mut abgs_simplify_report,
+) -> abgs_status {
+    guard("abgs_simplify", || {
+        // SAFETY: writable or NULL (checked).
+        let o = unsafe { out(out_grid, "out_grid")? };
+        *o = std::ptr::null_mut();
+        // SAFETY: a grid from this library or NULL (checked).
+        let h = unsafe { req(grid, "grid")? };
+        let mut defaults = None;
+        // SAFETY: readable or NULL (NULL = defaults).
+        let p = match unsafe { params.as_ref() } {
+            Some(p) => p,
+            None => {
+                let mut d = std::mem::MaybeUninit::<abgs_simplify_params>::uninit();
+                // SAFETY: a valid out-pointer to our own local.
+                unsafe { abgs_simplify_params_default(d.as_mut_ptr()) };
+                // SAFETY: just initialised by the call above.
+                defaults.insert(unsafe { d.assume_init() })
+            }
+        };
+        if p.method == abgs_method::ABGS_METHOD_GCN {
+            return err(
+                abgs_status::ABGS_ERR_NOT_AVAILABLE,
+                "the learned simplifier (GCN-ABGS) is not available in this build; use ABGS_METHOD_LBO",
+            );
+        }
+        let rp = to_params(p)?;
+        let g = h.read()?;
+        if g.sizes().is_none() {
+            return err(abgs_status::ABGS_ERR_NO_SIZES, "the grid has no sizes");
+        }
+        let (cb, user) = (p.progress, p.user_data);
+        let mut call = |r: &IterationRecord| -> bool {
+            let rec = record(r);
+            match cb {
+                // SAFETY: the caller guarantees the callback is safe to call
+                // with its user data; the record outlives the call.
+                Some(f) => unsafe { f(&rec, user) == 0 },
+                None => true,
+            }
+        };
+        let s = simplify::simplify(&g, &rp, Some(&mut call))?;
+        let r = &s.report;
+        // SAFETY: NULL or writable.
+        if let Some(rep) = unsafe { out_report.as_mut() } {
+            *rep = abgs_simplify_report {
+                faces_in: r.faces_in as u64,
+                vertices_in: r.vertices_in as u64,
+                faces_out: r.faces_out as u64,
+                vertices_out: r.vertices_out as u64,
+                iterations: r.iterations.len() as u64,
+                stop: match r.stop {
+                    StopReason::Converged => abgs_stop::ABGS_STOP_CONVERGED,
+                    StopReason::MaxIterations => abgs_stop::ABGS_STOP_MAX_ITERATIONS,
+                    StopReason::Cancelled => abgs_stop::ABGS_STOP_CANCELLED,
+                },
+                feature_lines: r.feature_lines as u64,
+                corners: r.corners as u64,
+                element_count_in: r.element_count_in,
+                element_count_out: r
+                    .iterations
+                    .last()
+                    .map_or(r.element_count_in, |i| i.element_count),
+                seconds: r.seconds,
+            };
+        }
+        let records = r.iterations.iter().map(record).collect();
+        *o = abgs_grid::boxed_simplified(s.grid, records);
+        Ok(())
+    })
+}
+
+/// Copies the record of iteration `index` (0-based, below
+/// `abgs_simplify_report.iterations`) of a grid made by `abgs_simplify` into
+/// `*out_record`. Errors: NULL, OUT_OF_RANGE (index, or a grid not made by
+/// `abgs_simplify`, which has no records).
+///
+/// # Safety
+/// Pointers are NULL (reported) or valid.
+#[no_mangle]
+pub unsafe extern "C" fn abgs_grid_simplify_iteration(
+    grid: *const abgs_grid,
+    index: usize,
+    out_record: *mut abgs_iteration_record,
+) -> abgs_status {
+    guard("abgs_grid_simplify_iteration", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let h = unsafe { req(grid, "grid")? };
+        let _g = h.read()?;
+        // SAFETY: writable or NULL (checked).
+        let o = unsafe { out(out_record, "out_record")? };
+        let recs = h.iterations();
+        *o = *recs.get(index).ok_or_else(|| {
+            FfiError(
+                abgs_status::ABGS_ERR_OUT_OF_RANGE,
+                format!("iteration {index} of {}", recs.len()),
+            )
+        })?;
+        Ok(())
+    })
+}
+
+/// Every edge's collapse estimate on `grid` as it is (the first iteration's
+/// view, exact Δs and Δd), in the order of `abgs_grid_copy_edges`: `out_ds`
+/// (Δs), `out_dd` (Δd / h_loc), `out_valid` (1 = the collapse passes the
+/// topological and geometric checks) and `out_y` (the score in [0, 1];
+/// < 0.5 = collapsible; 1 when invalid). Invalid edges get NaN in `out_ds` and
+/// `out_dd`. Each buffer holds `capacity` >= the edge count
+/// (`abgs_grid_stats.edges`) elements (`abgs_grid_edge_count`), else BUFFER_TOO_SMALL; any of the four
+/// may be NULL to skip it. `params` NULL = defaults (only the thresholds and
+/// angles are used). Parallel; the result does not depend on the thread count.
+/// Errors: NULL (grid), NON_FINITE / INVALID_ARGUMENT, NO_SIZES, BUSY.
+///
+/// # Safety
+/// Pointers are NULL or valid for `capacity` elements.
+#[no_mangle]
+pub unsafe extern "C" fn abgs_edge_scores(
+    grid: *const abgs_grid,
+    params: *const abgs_simplify_params,
+    out_ds: *mut f64,
+    out_dd: *mut f64,
+    out_valid: *mut u8,
+    out_y: *mut f64,
+    capacity: usize,
+) -> abgs_status {
+    guard("abgs_edge_scores", || {
+        // SAFETY: a grid from this library or NULL (checked).
+        let h = unsafe { req(grid, "grid")? };
+        // SAFETY: readable or NULL (NULL = defaults).
+        let rp = match unsafe { params.as_ref() } {
+            Some(p) => to_params(p)?,
+            None => SimplifyParams::default(),
+        };
+        let g = h.read()?;
+        if g.sizes().is_none() {
+            return err(abgs_status::ABGS_ERR_NO_SIZES, "the grid has no sizes");
+        }
+        let n = g.topology().edges.len();
+        if capacity < n {
+            return err(
+                abgs_status::ABGS_ERR_BUFFER_TOO_SMALL,
+                format!("capacity {capacity} < {n} edges"),
+            );
+        }
+        let scores = simplify::edge_scores(&g, &rp)?;
+        macro_rules! fill {
+            ($ptr:expr, $name:expr, $f:expr) => {
+                if !$ptr.is_null() {
+                    // SAFETY: non-NULL with `capacity` >= n writable elements by contract.
+                    let dst = unsafe { checked_out($ptr, capacity, n, $name)? };
+                    for (d, s) in dst.iter_mut().zip(&scores) {
+                        *d = $f(s);
+                    }
+                }
+            };
+        }
+        fill!(out_ds, "out_ds", |s: &simplify::EdgeScore| s.ds);
+        fill!(out_dd, "out_dd", |s: &simplify::EdgeScore| s.dd_rel);
+        fill!(out_valid, "out_valid", |s: &simplify::EdgeScore| u8::from(s.valid));
+        fill!(out_y, "out_y", |s: &simplify::EdgeScore| s.y);
+        Ok(())
+    })
+}
