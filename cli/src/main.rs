@@ -12,7 +12,8 @@ mod info;
 mod points;
 mod progress;
 mod query;
-#[allow(dead_code)] // Used by `abgs run` (to come).
+mod run;
+mod simplify;
 mod render;
 mod size;
 
@@ -128,6 +129,46 @@ enum Command {
         #[command(flatten)]
         args: eval::EvalArgs,
     },
+    /// Simplify a sized dense grid by LBO-ABGS (sizing-aware edge collapses), or by
+    /// plain QEM to a face count (the baseline); the result carries sizes.
+    Simplify {
+        /// Dense grid with sizes (e.g. from `abgs size`).
+        input: PathBuf,
+        /// Output file (vtk recommended).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Method.
+        #[arg(long, value_enum, default_value = "lbo")]
+        method: simplify::Method,
+        /// Face count for --method qem.
+        #[arg(long)]
+        target_faces: Option<usize>,
+        /// Write every parameter, the counts and the per-iteration table as JSON.
+        #[arg(long)]
+        report: Option<PathBuf>,
+        #[command(flatten)]
+        args: simplify::SimplifyArgs,
+    },
+    /// Score every edge of a sized grid as LBO-ABGS's first iteration would (Δs, Δd/h_loc,
+    /// valid, y): CSV, one line per edge, the learned simplifier's training labels.
+    Label {
+        /// Grid with sizes.
+        input: PathBuf,
+        /// Output CSV.
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        args: simplify::SimplifyArgs,
+    },
+    /// The whole pipeline: dense grid -> sizes -> LBO-ABGS -> evaluation, writing
+    /// DIR/dense.vtk, DIR/simplified.vtk, DIR/report.json, DIR/preview.png and
+    /// DIR/convergence.png.
+    Run {
+        /// Input surface (stl, obj, off, ply, msh, vtk, vtu, mesh).
+        input: PathBuf,
+        #[command(flatten)]
+        args: run::RunArgs,
+    },
 }
 
 fn main() -> ExitCode {
@@ -150,6 +191,20 @@ fn main() -> ExitCode {
         } => bench::run(&grid, points, seconds, json),
         Command::Size { grid, output, args } => size::run(&grid, &output, &args),
         Command::Eval { args } => eval::run(&args),
+        Command::Simplify {
+            input,
+            output,
+            method,
+            target_faces,
+            report,
+            args,
+        } => simplify::run(&input, &output, method, target_faces, &args, report.as_ref()),
+        Command::Label {
+            input,
+            output,
+            args,
+        } => simplify::label(&input, &output, &args),
+        Command::Run { input, args } => run::run(&input, &args),
         Command::Grid {
             input,
             output,

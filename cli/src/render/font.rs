@@ -125,6 +125,7 @@ pub fn glyph(c: char) -> [u16; 5] {
 }
 
 /// Whether font pixel (`col`, `row`) of the glyph for `c` is set (`col` < 5, `row` < 9).
+#[cfg(test)]
 pub fn pixel(c: char, col: u32, row: u32) -> bool {
     col < 5 && row < CELL_H - 1 && (glyph(c)[col as usize] >> row) & 1 == 1
 }

@@ -37,11 +37,13 @@ impl Image {
     }
 
     /// Width in pixels.
+    #[cfg(test)]
     pub fn width(&self) -> u32 {
         self.width
     }
 
     /// Height in pixels.
+    #[cfg(test)]
     pub fn height(&self) -> u32 {
         self.height
     }

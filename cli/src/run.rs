@@ -1,0 +1,261 @@
+//! `abgs run`: the whole pipeline on one surface, dense grid → sizes →
+//! simplification → evaluation, with a report and two pictures.
+
+use crate::render::{line_chart_png, preview_png, Panel, Series};
+use crate::simplify::{iterations_json, params_json, report_json, run_lbo, write_json};
+use abgs::metrics::{evaluate, EvalParams};
+use abgs::qem::{decimate, QemParams};
+use abgs::remesh::{remesh, RemeshParams, TargetLength};
+use abgs::simplify::SimplifyParams;
+use abgs::sizing::{self, SizeParams};
+use abgs::{Error, Grid, Result};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Options of `abgs run`.
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// Output folder (created if missing).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Dense grid: uniform edge length as a fraction of the diagonal.
+    #[arg(long, default_value_t = 0.01)]
+    pub relative: f64,
+    /// Feature angle in degrees (dense grid, sizes, simplification).
+    #[arg(long, default_value_t = 30.0)]
+    pub feature_angle: f64,
+    /// Elements per full circle (curvature sizes and the dense grid's curvature cap).
+    #[arg(long, default_value_t = 24.0)]
+    pub n_circle: f64,
+    /// Elements across a gap or wall.
+    #[arg(long, default_value_t = 3.0)]
+    pub n_gap: f64,
+    /// Gradation ratio β.
+    #[arg(long, default_value_t = 1.2)]
+    pub beta: f64,
+    /// Largest share of the edges collapsed per iteration (n).
+    #[arg(long, default_value_t = SimplifyParams::default().fraction)]
+    pub fraction: f64,
+    /// Largest size ratio a collapse may cause (T_size).
+    #[arg(long, default_value_t = SimplifyParams::default().t_size)]
+    pub t_size: f64,
+    /// Largest distance to the dense grid as a fraction of the local size (τ_d).
+    #[arg(long, default_value_t = SimplifyParams::default().tau_d)]
+    pub tau_d: f64,
+    /// Largest distance to the dense grid in model units (default: no limit).
+    #[arg(long)]
+    pub max_distance: Option<f64>,
+    /// Most simplification iterations.
+    #[arg(long = "max-iter", default_value_t = SimplifyParams::default().max_iterations)]
+    pub max_iterations: usize,
+    /// Also decimate the dense grid by plain QEM to the same face count (sizes
+    /// re-projected) and evaluate it: what sizing-awareness buys.
+    #[arg(long)]
+    pub qem: bool,
+    /// Points sampled for the size deviation and for each side of the Hausdorff distance.
+    #[arg(long, default_value_t = 100_000)]
+    pub samples: usize,
+    /// Do not write preview.png and convergence.png.
+    #[arg(long)]
+    pub no_images: bool,
+}
+
+fn stage<T>(name: &str, times: &mut Vec<(String, f64)>, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    let pb = crate::progress::spinner(name.to_string());
+    let t = Instant::now();
+    let r = f();
+    pb.finish_and_clear();
+    let s = t.elapsed().as_secs_f64();
+    times.push((name.to_string(), s));
+    if r.is_ok() {
+        eprintln!("{name}: {s:.2} s");
+    }
+    r
+}
+
+/// Runs `abgs run`.
+pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
+    std::fs::create_dir_all(&a.output).map_err(|e| Error::io(&a.output, e))?;
+    let start = Instant::now();
+    let mut times: Vec<(String, f64)> = Vec::new();
+    let surface = stage("load", &mut times, || Grid::load(input))?;
+    let rp = RemeshParams {
+        target: TargetLength::Relative(a.relative),
+        feature_angle_deg: a.feature_angle,
+        n_circle: a.n_circle,
+        ..Default::default()
+    };
+    let remeshed = stage("dense grid", &mut times, || remesh(&surface, &rp))?;
+    let mut dense = remeshed.grid;
+    let sp = SizeParams {
+        n_circle: a.n_circle,
+        n_gap: a.n_gap,
+        feature_angle_deg: a.feature_angle,
+        gradation: Some(sizing::Gradation::Beta(a.beta)),
+        ..Default::default()
+    };
+    let fields = stage("sizes", &mut times, || sizing::compute(&dense, &sp))?;
+    dense.set_sizes(fields.h.clone())?;
+    let params = SimplifyParams {
+        fraction: a.fraction,
+        t_size: a.t_size,
+        tau_d: a.tau_d,
+        max_distance: a.max_distance,
+        max_iterations: a.max_iterations,
+        feature_angle_deg: a.feature_angle,
+        ..Default::default()
+    };
+    let t = Instant::now();
+    let simplified = run_lbo(&dense, &params)?;
+    times.push(("simplify".into(), t.elapsed().as_secs_f64()));
+    eprintln!(
+        "simplify: {:.2} s ({} -> {} faces, {} iterations)",
+        t.elapsed().as_secs_f64(),
+        simplified.report.faces_in,
+        simplified.report.faces_out,
+        simplified.report.iterations.len()
+    );
+    let ep = EvalParams {
+        samples: a.samples,
+        hausdorff_samples: a.samples,
+        ..Default::default()
+    };
+    let eval = stage("evaluate", &mut times, || evaluate(&dense, &simplified.grid, &ep))?;
+    let dense_path = a.output.join("dense.vtk");
+    let simp_path = a.output.join("simplified.vtk");
+    stage("write grids", &mut times, || {
+        dense.save(&dense_path)?;
+        simplified.grid.save(&simp_path)
+    })?;
+    let qem = if a.qem {
+        let q = stage("qem baseline", &mut times, || {
+            decimate(
+                &dense,
+                &QemParams {
+                    target_faces: simplified.grid.triangles().len(),
+                    feature_angle_deg: a.feature_angle,
+                    ..Default::default()
+                },
+            )
+        })?;
+        let qe = stage("evaluate qem", &mut times, || evaluate(&dense, &q.grid, &ep))?;
+        q.grid.save(&a.output.join("qem.vtk"))?;
+        Some((q, qe))
+    } else {
+        None
+    };
+    if !a.no_images {
+        stage("images", &mut times, || images(&a.output, &dense, &simplified))?;
+    }
+    let mut report = json!({
+        "input": input,
+        "outputs": {
+            "dense": dense_path, "simplified": simp_path,
+            "report": a.output.join("report.json"),
+        },
+        "parameters": {
+            "dense_grid": {"relative_length": a.relative, "feature_angle_deg": a.feature_angle,
+                           "n_circle": a.n_circle, "curvature_limit": rp.curvature_limit,
+                           "iterations": rp.iterations},
+            "sizes": {"n_circle": a.n_circle, "n_gap": a.n_gap, "beta": a.beta,
+                      "hmin": fields.report.hmin, "hmax": fields.report.hmax,
+                      "feature_angle_deg": a.feature_angle},
+            "simplify": params_json(&params),
+            "evaluation": {"samples": ep.samples, "hausdorff_samples": ep.hausdorff_samples, "seed": ep.seed},
+        },
+        "counts": {
+            "input_faces": surface.triangles().len(),
+            "dense_faces": dense.triangles().len(),
+            "dense_vertices": dense.vertices().len(),
+            "simplified_faces": simplified.grid.triangles().len(),
+            "simplified_vertices": simplified.grid.vertices().len(),
+        },
+        "simplify": report_json(&simplified),
+        "metrics": crate::eval::evaluation_json(&eval),
+        "iterations": iterations_json(&simplified.report.iterations),
+    });
+    if let Some((q, qe)) = &qem {
+        report["qem"] = json!({
+            "faces": q.grid.triangles().len(), "collapses": q.collapses, "seconds": q.seconds,
+            "metrics": crate::eval::evaluation_json(qe),
+        });
+    }
+    let total = start.elapsed().as_secs_f64();
+    let mut st: serde_json::Map<String, Value> = times.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
+    st.insert("total".into(), json!(total));
+    report["seconds"] = Value::Object(st);
+    write_json(&a.output.join("report.json"), &report)?;
+    print_summary(&eval, qem.as_ref().map(|x| &x.1), total);
+    Ok(())
+}
+
+fn print_summary(e: &abgs::metrics::Evaluation, qem: Option<&abgs::metrics::Evaluation>, total: f64) {
+    let row = |name: &str, e: &abgs::metrics::Evaluation| {
+        eprintln!(
+            "{name:<9} faces {:>9} -> {:>8}  reduction {:5.1} %  size deviation mean {:.3} p95 {:.3} max {:.3}  hausdorff {:.3} %  elements {:+.2} %",
+            e.faces_reference,
+            e.faces_candidate,
+            100.0 * e.reduction,
+            e.size_deviation.mean,
+            e.size_deviation.p95,
+            e.size_deviation.max,
+            100.0 * e.hausdorff_relative,
+            100.0 * e.element_count_change
+        );
+    };
+    row("lbo-abgs", e);
+    if let Some(q) = qem {
+        row("qem", q);
+    }
+    eprintln!("total {total:.2} s");
+}
+
+fn images(dir: &Path, dense: &Grid, s: &abgs::simplify::Simplified) -> Result<()> {
+    let io = |m: String| Error::InvalidArgument(format!("image: {m}"));
+    let (dh, sh) = (dense.sizes().unwrap_or(&[]), s.grid.sizes().unwrap_or(&[]));
+    let nd = dense.triangles().len();
+    let ns = s.grid.triangles().len();
+    let panels = [
+        Panel {
+            title: format!("dense: {nd} faces"),
+            vertices: dense.vertices(),
+            triangles: dense.triangles(),
+            values: dh,
+        },
+        Panel {
+            title: format!(
+                "LBO-ABGS: {ns} faces (-{:.1} %)",
+                100.0 * (1.0 - ns as f64 / nd.max(1) as f64)
+            ),
+            vertices: s.grid.vertices(),
+            triangles: s.grid.triangles(),
+            values: sh,
+        },
+    ];
+    preview_png(&panels, "size h", 1600, 800, &dir.join("preview.png")).map_err(io)?;
+    let mut faces = vec![s.report.faces_in as f64];
+    let mut elems = vec![s.report.element_count_in];
+    for r in &s.report.iterations {
+        faces.push(r.faces as f64);
+        elems.push(r.element_count);
+    }
+    line_chart_png(
+        "LBO-ABGS convergence",
+        "iteration",
+        &[
+            Series {
+                name: "grid faces".into(),
+                values: &faces,
+            },
+            Series {
+                name: "estimated elements (4/sqrt3 int h^-2)".into(),
+                values: &elems,
+            },
+        ],
+        1000,
+        600,
+        &dir.join("convergence.png"),
+    )
+    .map_err(io)
+}

@@ -1,0 +1,242 @@
+//! `abgs simplify` (LBO-ABGS or the QEM baseline) and `abgs label` (per-edge
+//! scores, the learned simplifier's training labels).
+
+use abgs::qem::{decimate, QemParams};
+use abgs::simplify::{edge_scores, simplify, IterationRecord, SimplifyParams, Simplified, StopReason};
+use abgs::{Error, Grid, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde_json::{json, Value};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Simplification method of `abgs simplify`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum, PartialEq, Eq)]
+pub enum Method {
+    /// LBO-ABGS: sizing-aware edge collapses, each estimated exactly.
+    Lbo,
+    /// Plain quadric-error decimation to `--target-faces` (the baseline), sizes re-projected.
+    Qem,
+}
+
+/// Options of LBO-ABGS (mirrors [`SimplifyParams`]).
+#[derive(clap::Args, Debug, Clone)]
+pub struct SimplifyArgs {
+    /// Largest share of the edges collapsed per iteration (n).
+    #[arg(long, default_value_t = SimplifyParams::default().fraction)]
+    pub fraction: f64,
+    /// Largest size ratio a collapse may cause (T_size).
+    #[arg(long, default_value_t = SimplifyParams::default().t_size)]
+    pub t_size: f64,
+    /// Largest distance to the dense grid as a fraction of the local size (τ_d).
+    #[arg(long, default_value_t = SimplifyParams::default().tau_d)]
+    pub tau_d: f64,
+    /// Largest distance to the dense grid in model units (default: no limit).
+    #[arg(long)]
+    pub max_distance: Option<f64>,
+    /// Most iterations.
+    #[arg(long = "max-iter", default_value_t = SimplifyParams::default().max_iterations)]
+    pub max_iterations: usize,
+    /// Feature angle in degrees.
+    #[arg(long, default_value_t = SimplifyParams::default().feature_angle_deg)]
+    pub feature_angle: f64,
+    /// No local repair (relaxation, flips) after each batch.
+    #[arg(long)]
+    pub no_repair: bool,
+}
+
+impl SimplifyArgs {
+    /// The library parameters.
+    pub fn params(&self) -> SimplifyParams {
+        SimplifyParams {
+            fraction: self.fraction,
+            t_size: self.t_size,
+            tau_d: self.tau_d,
+            max_distance: self.max_distance,
+            max_iterations: self.max_iterations,
+            feature_angle_deg: self.feature_angle,
+            repair: !self.no_repair,
+            ..Default::default()
+        }
+    }
+}
+
+/// Every parameter as JSON.
+pub fn params_json(p: &SimplifyParams) -> Value {
+    json!({
+        "method": "lbo",
+        "fraction": p.fraction, "pool_factor": p.pool_factor, "t_size": p.t_size,
+        "tau_d": p.tau_d, "max_distance": p.max_distance, "max_iterations": p.max_iterations,
+        "feature_angle_deg": p.feature_angle_deg, "corner_angle_deg": p.corner_angle_deg,
+        "max_normal_turn_deg": p.max_normal_turn_deg, "max_angle_deg": p.max_angle_deg,
+        "repair": p.repair,
+    })
+}
+
+/// The per-iteration table as JSON rows.
+pub fn iterations_json(its: &[IterationRecord]) -> Value {
+    Value::Array(
+        its.iter()
+            .map(|r| {
+                json!({
+                    "iteration": r.iteration, "faces": r.faces, "vertices": r.vertices,
+                    "candidates": r.candidates, "estimated": r.estimated,
+                    "collapsible": r.collapsible, "accepted": r.accepted, "moved": r.moved,
+                    "flips": r.flips, "element_count": r.element_count, "seconds": r.seconds,
+                })
+            })
+            .collect(),
+    )
+}
+
+/// What a simplification did, as JSON.
+pub fn report_json(s: &Simplified) -> Value {
+    let r = &s.report;
+    json!({
+        "faces_in": r.faces_in, "vertices_in": r.vertices_in,
+        "faces_out": r.faces_out, "vertices_out": r.vertices_out,
+        "feature_lines": r.feature_lines, "corners": r.corners,
+        "element_count_in": r.element_count_in,
+        "stop": match r.stop {
+            StopReason::Converged => "converged",
+            StopReason::MaxIterations => "max_iterations",
+            StopReason::Cancelled => "cancelled",
+        },
+        "seconds": r.seconds,
+        "iterations": iterations_json(&r.iterations),
+    })
+}
+
+/// Runs LBO-ABGS with a progress bar on stderr (faces so far; hidden when
+/// stderr is not a terminal).
+pub fn run_lbo(dense: &Grid, params: &SimplifyParams) -> Result<Simplified> {
+    let pb = ProgressBar::new(dense.triangles().len() as u64);
+    pb.set_style(
+        ProgressStyle::with_template(
+            "simplifying {bar:30} {msg} [{elapsed}]",
+        )
+        .expect("valid template"),
+    );
+    let mut cb = |r: &IterationRecord| {
+        pb.set_position((dense.triangles().len() - r.faces) as u64);
+        pb.set_message(format!("iteration {} · {} faces", r.iteration, r.faces));
+        true
+    };
+    let s = simplify(dense, params, Some(&mut cb));
+    pb.finish_and_clear();
+    s
+}
+
+/// Runs `abgs simplify`.
+pub fn run(
+    input: &Path,
+    output: &Path,
+    method: Method,
+    target_faces: Option<usize>,
+    args: &SimplifyArgs,
+    report: Option<&PathBuf>,
+) -> Result<()> {
+    let dense = crate::progress::load(input)?;
+    if dense.sizes().is_none() {
+        return Err(Error::InvalidArgument(format!(
+            "{} has no sizes (point array 'size'): make one with `abgs size`",
+            input.display()
+        )));
+    }
+    let value = match method {
+        Method::Lbo => {
+            let params = args.params();
+            let s = run_lbo(&dense, &params)?;
+            s.grid.save(output)?;
+            let r = &s.report;
+            eprintln!(
+                "wrote {} ({} vertices, {} triangles)",
+                output.display(),
+                r.vertices_out,
+                r.faces_out
+            );
+            eprintln!(
+                "faces {} -> {} ({:.1} % fewer) in {} iterations ({:?}), {:.2} s",
+                r.faces_in,
+                r.faces_out,
+                100.0 * (1.0 - r.faces_out as f64 / r.faces_in.max(1) as f64),
+                r.iterations.len(),
+                r.stop,
+                r.seconds
+            );
+            json!({"input": input, "output": output, "parameters": params_json(&params), "report": report_json(&s)})
+        }
+        Method::Qem => {
+            let Some(faces) = target_faces else {
+                return Err(Error::InvalidArgument(
+                    "--method qem needs --target-faces".into(),
+                ));
+            };
+            let p = QemParams {
+                target_faces: faces,
+                feature_angle_deg: args.feature_angle,
+                ..Default::default()
+            };
+            let d = decimate(&dense, &p)?;
+            d.grid.save(output)?;
+            eprintln!(
+                "wrote {} ({} triangles, {} collapses, {:.2} s)",
+                output.display(),
+                d.grid.triangles().len(),
+                d.collapses,
+                d.seconds
+            );
+            json!({"input": input, "output": output, "parameters": {"method": "qem", "target_faces": faces,
+                   "feature_angle_deg": p.feature_angle_deg}, "report": {"faces_in": dense.triangles().len(),
+                   "faces_out": d.grid.triangles().len(), "collapses": d.collapses, "seconds": d.seconds}})
+        }
+    };
+    if let Some(path) = report {
+        write_json(path, &value)?;
+    }
+    Ok(())
+}
+
+/// Writes pretty JSON to `path`.
+pub fn write_json(path: &Path, v: &Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(v).expect("JSON values serialise");
+    std::fs::write(path, text + "\n").map_err(|e| Error::io(path, e))
+}
+
+/// Runs `abgs label`: one line per edge, `a b ds dd_rel valid y` (CSV with a
+/// header), in the grid's edge order.
+pub fn label(input: &Path, output: &Path, args: &SimplifyArgs) -> Result<()> {
+    let g = crate::progress::load(input)?;
+    let pb = crate::progress::spinner(format!("scoring {} edges", g.topology().edges.len()));
+    let scores = edge_scores(&g, &args.params());
+    pb.finish_and_clear();
+    let scores = scores?;
+    let io = |e: std::io::Error| Error::io(output, e);
+    let f = std::fs::File::create(output).map_err(io)?;
+    let mut w = std::io::BufWriter::new(f);
+    writeln!(w, "a,b,ds,dd_rel,valid,y").map_err(io)?;
+    let num = |x: f64| if x.is_nan() { String::new() } else { format!("{x:.9e}") };
+    for s in &scores {
+        writeln!(
+            w,
+            "{},{},{},{},{},{:.9e}",
+            s.vertices[0],
+            s.vertices[1],
+            num(s.ds),
+            num(s.dd_rel),
+            u8::from(s.valid),
+            s.y
+        )
+        .map_err(io)?;
+    }
+    w.flush().map_err(io)?;
+    let coll = scores.iter().filter(|s| s.y < 0.5).count();
+    let valid = scores.iter().filter(|s| s.valid).count();
+    eprintln!(
+        "wrote {} ({} edges: {} valid, {} collapsible)",
+        output.display(),
+        scores.len(),
+        valid,
+        coll
+    );
+    Ok(())
+}
