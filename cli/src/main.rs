@@ -12,9 +12,9 @@ mod info;
 mod points;
 mod progress;
 mod query;
+mod render;
 mod run;
 mod simplify;
-mod render;
 mod size;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -198,7 +198,14 @@ fn main() -> ExitCode {
             target_faces,
             report,
             args,
-        } => simplify::run(&input, &output, method, target_faces, &args, report.as_ref()),
+        } => simplify::run(
+            &input,
+            &output,
+            method,
+            target_faces,
+            &args,
+            report.as_ref(),
+        ),
         Command::Label {
             input,
             output,

@@ -61,7 +61,11 @@ pub struct RunArgs {
     pub no_images: bool,
 }
 
-fn stage<T>(name: &str, times: &mut Vec<(String, f64)>, f: impl FnOnce() -> Result<T>) -> Result<T> {
+fn stage<T>(
+    name: &str,
+    times: &mut Vec<(String, f64)>,
+    f: impl FnOnce() -> Result<T>,
+) -> Result<T> {
     let pb = crate::progress::spinner(name.to_string());
     let t = Instant::now();
     let r = f();
@@ -121,7 +125,9 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         hausdorff_samples: a.samples,
         ..Default::default()
     };
-    let eval = stage("evaluate", &mut times, || evaluate(&dense, &simplified.grid, &ep))?;
+    let eval = stage("evaluate", &mut times, || {
+        evaluate(&dense, &simplified.grid, &ep)
+    })?;
     let dense_path = a.output.join("dense.vtk");
     let simp_path = a.output.join("simplified.vtk");
     stage("write grids", &mut times, || {
@@ -139,14 +145,18 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
                 },
             )
         })?;
-        let qe = stage("evaluate qem", &mut times, || evaluate(&dense, &q.grid, &ep))?;
+        let qe = stage("evaluate qem", &mut times, || {
+            evaluate(&dense, &q.grid, &ep)
+        })?;
         q.grid.save(&a.output.join("qem.vtk"))?;
         Some((q, qe))
     } else {
         None
     };
     if !a.no_images {
-        stage("images", &mut times, || images(&a.output, &dense, &simplified))?;
+        stage("images", &mut times, || {
+            images(&a.output, &dense, &simplified)
+        })?;
     }
     let mut report = json!({
         "input": input,
@@ -182,7 +192,8 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         });
     }
     let total = start.elapsed().as_secs_f64();
-    let mut st: serde_json::Map<String, Value> = times.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
+    let mut st: serde_json::Map<String, Value> =
+        times.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
     st.insert("total".into(), json!(total));
     report["seconds"] = Value::Object(st);
     write_json(&a.output.join("report.json"), &report)?;
@@ -190,7 +201,11 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
     Ok(())
 }
 
-fn print_summary(e: &abgs::metrics::Evaluation, qem: Option<&abgs::metrics::Evaluation>, total: f64) {
+fn print_summary(
+    e: &abgs::metrics::Evaluation,
+    qem: Option<&abgs::metrics::Evaluation>,
+    total: f64,
+) {
     let row = |name: &str, e: &abgs::metrics::Evaluation| {
         eprintln!(
             "{name:<9} faces {:>9} -> {:>8}  reduction {:5.1} %  size deviation mean {:.3} p95 {:.3} max {:.3}  hausdorff {:.3} %  elements {:+.2} %",

@@ -2,7 +2,9 @@
 //! scores, the learned simplifier's training labels).
 
 use abgs::qem::{decimate, QemParams};
-use abgs::simplify::{edge_scores, simplify, IterationRecord, SimplifyParams, Simplified, StopReason};
+use abgs::simplify::{
+    edge_scores, simplify, IterationRecord, Simplified, SimplifyParams, StopReason,
+};
 use abgs::{Error, Grid, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::{json, Value};
@@ -111,10 +113,8 @@ pub fn report_json(s: &Simplified) -> Value {
 pub fn run_lbo(dense: &Grid, params: &SimplifyParams) -> Result<Simplified> {
     let pb = ProgressBar::new(dense.triangles().len() as u64);
     pb.set_style(
-        ProgressStyle::with_template(
-            "simplifying {bar:30} {msg} [{elapsed}]",
-        )
-        .expect("valid template"),
+        ProgressStyle::with_template("simplifying {bar:30} {msg} [{elapsed}]")
+            .expect("valid template"),
     );
     let mut cb = |r: &IterationRecord| {
         pb.set_position((dense.triangles().len() - r.faces) as u64);
@@ -214,7 +214,13 @@ pub fn label(input: &Path, output: &Path, args: &SimplifyArgs) -> Result<()> {
     let f = std::fs::File::create(output).map_err(io)?;
     let mut w = std::io::BufWriter::new(f);
     writeln!(w, "a,b,ds,dd_rel,valid,y").map_err(io)?;
-    let num = |x: f64| if x.is_nan() { String::new() } else { format!("{x:.9e}") };
+    let num = |x: f64| {
+        if x.is_nan() {
+            String::new()
+        } else {
+            format!("{x:.9e}")
+        }
+    };
     for s in &scores {
         writeln!(
             w,

@@ -544,3 +544,182 @@ fn eval_reports_json_and_a_table() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("no sizes"));
 }
+
+/// A plate subdivided n × n with sizes 0.02 + 0.2·x, written as VTK.
+fn dense_plate(tag: &str, n: usize) -> PathBuf {
+    let path = tmp(&format!("dense-plate-{tag}.vtk"));
+    let mut v = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            v.push([i as f64 / n as f64, j as f64 / n as f64, 0.0]);
+        }
+    }
+    let mut t = Vec::new();
+    for j in 0..n as u32 {
+        for i in 0..n as u32 {
+            let a = j * (n as u32 + 1) + i;
+            let (b, c, d) = (a + 1, a + n as u32 + 2, a + n as u32 + 1);
+            t.push([a, b, c]);
+            t.push([a, c, d]);
+        }
+    }
+    let s = v.iter().map(|p| 0.02 + 0.2 * p[0]).collect();
+    abgs::Grid::from_arrays(v, t, Some(s), &abgs::BuildOptions::default())
+        .unwrap()
+        .save(&path)
+        .unwrap();
+    path
+}
+
+#[test]
+fn simplify_lbo_and_qem_write_grids_with_sizes_and_a_report() {
+    let dense = dense_plate("simp", 30);
+    let out = tmp("simp-out.vtk");
+    let rep = tmp("simp-report.json");
+    let o = abgs()
+        .args(["simplify"])
+        .arg(&dense)
+        .arg("-o")
+        .arg(&out)
+        .arg("--report")
+        .arg(&rep)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let g = abgs::Grid::load(&out).unwrap();
+    assert!(g.sizes().is_some());
+    assert!(g.triangles().len() < 1800 / 2);
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    assert_eq!(r["parameters"]["t_size"], 1.2);
+    assert_eq!(r["report"]["faces_out"], g.triangles().len());
+    let its = r["report"]["iterations"].as_array().unwrap();
+    assert!(its.len() >= 2);
+    assert_eq!(its.last().unwrap()["faces"], g.triangles().len());
+    // The QEM baseline to a face count.
+    let q = tmp("simp-qem.vtk");
+    let o = abgs()
+        .args(["simplify", "--method", "qem", "--target-faces", "100"])
+        .arg(&dense)
+        .arg("-o")
+        .arg(&q)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let g = abgs::Grid::load(&q).unwrap();
+    assert!(g.sizes().is_some() && g.triangles().len() <= 100);
+    // Errors: qem without a face count, a grid without sizes, bad thresholds.
+    for args in [
+        vec!["--method", "qem"],
+        vec!["--t-size", "1.0"],
+        vec!["--fraction", "0"],
+    ] {
+        let o = abgs()
+            .arg("simplify")
+            .arg(&dense)
+            .arg("-o")
+            .arg(&q)
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(1), "{args:?}");
+        assert!(!o.stderr.is_empty());
+    }
+    let o = abgs()
+        .arg("simplify")
+        .arg(box_obj("simp"))
+        .arg("-o")
+        .arg(&q)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no sizes"));
+}
+
+#[test]
+fn label_writes_one_line_per_edge() {
+    let dense = dense_plate("label", 12);
+    let out = tmp("labels.csv");
+    let o = abgs()
+        .arg("label")
+        .arg(&dense)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("a,b,ds,dd_rel,valid,y"));
+    let g = abgs::Grid::load(&dense).unwrap();
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), g.topology().edges.len());
+    let mut collapsible = 0;
+    for (row, e) in rows.iter().zip(&g.topology().edges) {
+        let f: Vec<&str> = row.split(',').collect();
+        assert_eq!(f.len(), 6);
+        assert_eq!(
+            [f[0].parse::<u32>().unwrap(), f[1].parse::<u32>().unwrap()],
+            *e
+        );
+        let y: f64 = f[5].parse().unwrap();
+        assert!((0.0..=1.0).contains(&y));
+        if f[4] == "0" {
+            assert_eq!(y, 1.0);
+            assert!(f[2].is_empty());
+        } else if y < 0.5 {
+            collapsible += 1;
+        }
+    }
+    assert!(collapsible > 0);
+}
+
+#[test]
+fn run_writes_grids_report_and_pictures() {
+    let dir = tmp("run-box");
+    let o = abgs()
+        .arg("run")
+        .arg(box_obj("run"))
+        .arg("-o")
+        .arg(&dir)
+        .args(["--relative", "0.05", "--qem", "--samples", "20000"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in [
+        "dense.vtk",
+        "simplified.vtk",
+        "qem.vtk",
+        "report.json",
+        "preview.png",
+        "convergence.png",
+    ] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let dense = abgs::Grid::load(&dir.join("dense.vtk")).unwrap();
+    let simp = abgs::Grid::load(&dir.join("simplified.vtk")).unwrap();
+    assert_eq!(r["counts"]["dense_faces"], dense.triangles().len());
+    assert_eq!(r["counts"]["simplified_faces"], simp.triangles().len());
+    assert!(simp.triangles().len() < dense.triangles().len());
+    let m = &r["metrics"];
+    assert!(m["reduction"].as_f64().unwrap() > 0.0);
+    assert!(m["size_deviation"]["p95"].as_f64().unwrap() <= 1.2);
+    assert!(m["hausdorff_relative"].as_f64().unwrap() < 1e-3);
+    assert!(r["qem"]["metrics"]["reduction"].is_number());
+    for stage in [
+        "dense grid",
+        "sizes",
+        "simplify",
+        "evaluate",
+        "images",
+        "total",
+    ] {
+        assert!(r["seconds"][stage].is_number(), "{stage}");
+    }
+    assert!(!r["iterations"].as_array().unwrap().is_empty());
+    assert_eq!(r["parameters"]["simplify"]["tau_d"], 0.05);
+    let png = std::fs::read(dir.join("preview.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}

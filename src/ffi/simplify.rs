@@ -60,8 +60,9 @@ pub struct abgs_iteration_record {
 
 /// Called after every iteration with its record and `user_data`; return 0 to
 /// go on, anything else to stop (the grid made so far is returned, valid).
-pub type abgs_progress_fn =
-    Option<unsafe extern "C" fn(record: *const abgs_iteration_record, user_data: *mut c_void) -> i32>;
+pub type abgs_progress_fn = Option<
+    unsafe extern "C" fn(record: *const abgs_iteration_record, user_data: *mut c_void) -> i32,
+>;
 
 /// Parameters of `abgs_simplify`; get the defaults from
 /// `abgs_simplify_params_default`. A NaN or infinite value gives
@@ -182,7 +183,10 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
     if p.max_distance < 0.0 {
         return err(
             abgs_status::ABGS_ERR_INVALID_ARGUMENT,
-            format!("max_distance = {} must be >= 0 (0 = no limit)", p.max_distance),
+            format!(
+                "max_distance = {} must be >= 0 (0 = no limit)",
+                p.max_distance
+            ),
         );
     }
     if p.max_iterations == 0 {
@@ -408,7 +412,9 @@ pub unsafe extern "C" fn abgs_edge_scores(
         }
         fill!(out_ds, "out_ds", |s: &simplify::EdgeScore| s.ds);
         fill!(out_dd, "out_dd", |s: &simplify::EdgeScore| s.dd_rel);
-        fill!(out_valid, "out_valid", |s: &simplify::EdgeScore| u8::from(s.valid));
+        fill!(out_valid, "out_valid", |s: &simplify::EdgeScore| u8::from(
+            s.valid
+        ));
         fill!(out_y, "out_y", |s: &simplify::EdgeScore| s.y);
         Ok(())
     })

@@ -559,4 +559,3 @@ pub fn edge_scores(grid: &Grid, params: &SimplifyParams) -> Result<Vec<EdgeScore
     }
     Ok(out)
 }
-
