@@ -58,7 +58,7 @@ pub struct abgs_iteration_record {
     pub seconds: f64,
 }
 
-/// Called after every iteration with its record and `user_data`; return 0 to
+/// Called after every iteration that collapsed something, with its record and `user_data`; return 0 to
 /// go on, anything else to stop (the grid made so far is returned, valid).
 pub type abgs_progress_fn = Option<
     unsafe extern "C" fn(record: *const abgs_iteration_record, user_data: *mut c_void) -> i32,
@@ -234,8 +234,8 @@ fn record(r: &IterationRecord) -> abgs_iteration_record {
 /// surface within `tau_d`·h (and `max_distance`) of it; feature lines,
 /// corners, boundaries and bodies are kept. `params` NULL = the defaults.
 ///
-/// `progress` (if set) is called after every iteration, on the calling
-/// thread; a non-zero return stops the loop and the grid made so far is
+/// `progress` (if set) is called after every iteration that collapsed
+/// something (not after the last, empty one), on the calling thread; a non-zero return stops the loop and the grid made so far is
 /// returned (status OK, `stop` = ABGS_STOP_CANCELLED). On success `*out_grid`
 /// owns the new grid, whose handle also holds the per-iteration records
 /// (`abgs_grid_simplify_iteration`); on failure it is NULL. `out_report` (may

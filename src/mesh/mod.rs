@@ -3,7 +3,7 @@
 
 pub mod features;
 pub mod halfedge;
-mod stats;
+pub(crate) mod stats;
 mod topology;
 mod validate;
 pub mod weld;

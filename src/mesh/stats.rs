@@ -58,7 +58,8 @@ pub(crate) fn count_slivers(v: &[[f64; 3]], t: &[[u32; 3]], deg: f64) -> usize {
         .count()
 }
 
-fn percentile(sorted: &[f64], q: f64) -> f64 {
+/// Nearest-rank percentile `q ∈ [0, 1]` of a sorted slice (NaN when empty).
+pub(crate) fn percentile(sorted: &[f64], q: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
     }
@@ -67,8 +68,9 @@ fn percentile(sorted: &[f64], q: f64) -> f64 {
 }
 
 impl Grid {
-    /// Angle statistics over all triangles. O(F log F).
-    pub fn angle_stats(&self) -> AngleStats {
+    /// The smallest and the largest angle (degrees) of every triangle, each
+    /// list sorted ascending. Parallel, deterministic. O(F log F).
+    pub(crate) fn sorted_angles(&self) -> (Vec<f64>, Vec<f64>) {
         let v = self.vertices();
         let (mut mins, mut maxs): (Vec<f64>, Vec<f64>) = self
             .triangles()
@@ -80,6 +82,12 @@ impl Grid {
             .unzip();
         mins.par_sort_unstable_by(f64::total_cmp);
         maxs.par_sort_unstable_by(f64::total_cmp);
+        (mins, maxs)
+    }
+
+    /// Angle statistics over all triangles. O(F log F).
+    pub fn angle_stats(&self) -> AngleStats {
+        let (mins, maxs) = self.sorted_angles();
         AngleStats {
             min_angle: mins.first().copied().unwrap_or(f64::NAN),
             min_angle_p1: percentile(&mins, 0.01),

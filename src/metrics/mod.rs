@@ -18,7 +18,8 @@
 //! fixed order; maxima are order-independent).
 
 use crate::error::{Error, Result};
-use crate::geometry::{closest_point_triangle, triangle_angles_deg, triangle_area, Aabb};
+use crate::geometry::{closest_point_triangle, triangle_area, Aabb};
+use crate::mesh::stats::percentile;
 use crate::mesh::Grid;
 use crate::sampling::surface_points;
 use rayon::prelude::*;
@@ -228,7 +229,7 @@ pub fn size_deviation(
 
 /// The 7-point degree-5 rule on a triangle (Radon; Dunavant's degree-5 rule):
 /// barycentric coordinates and weights summing to 1.
-fn quadrature() -> [([f64; 3], f64); 7] {
+pub(crate) fn quadrature() -> [([f64; 3], f64); 7] {
     let s = 15f64.sqrt();
     let (a1, b1, w1) = (
         (6.0 - s) / 21.0,
@@ -324,17 +325,7 @@ pub fn estimated_element_count(surface: &Grid, sizing: Option<&Grid>) -> Result<
 /// Smallest and largest angle per face of `grid`, summarised (see
 /// [`AngleStats`]). Parallel, deterministic. O(F log F).
 pub fn angle_stats(grid: &Grid) -> AngleStats {
-    let v = grid.vertices();
-    let (mut mins, mut maxs): (Vec<f64>, Vec<f64>) = grid
-        .triangles()
-        .par_iter()
-        .map(|t| {
-            let a = triangle_angles_deg(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]);
-            (a[0].min(a[1]).min(a[2]), a[0].max(a[1]).max(a[2]))
-        })
-        .unzip();
-    mins.par_sort_unstable_by(f64::total_cmp);
-    maxs.par_sort_unstable_by(f64::total_cmp);
+    let (mins, maxs) = grid.sorted_angles();
     AngleStats {
         min: mins.first().copied().unwrap_or(f64::NAN),
         min_p1: percentile(&mins, 0.01),
@@ -431,12 +422,4 @@ fn positive(h: f64, what: &str, p: [f64; 3]) -> Result<f64> {
     } else {
         Err(Error::InvalidSize(format!("{what} size {h} at {p:?}")))
     }
-}
-
-/// Nearest-rank percentile `q ∈ [0, 1]` of a sorted slice (NaN when empty).
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    sorted[((sorted.len() - 1) as f64 * q).round() as usize]
 }

@@ -279,8 +279,8 @@ fn star_normal(mesh: &HalfedgeMesh, v: u32, patch: u32) -> [f64; 3] {
     n
 }
 
-/// The faces around `v` after moving it to `p` (skipping faces that contain
-/// `skip`, and replacing `v` by `as_vertex` in them), with validity checks.
+/// The faces around `v` with `v` moved to `p` (size `size`), skipping those
+/// that contain `skip` (they vanish in the collapse), with validity checks.
 /// Appends to `fan`; false when a face fails [`face_ok`].
 #[allow(clippy::too_many_arguments)]
 fn moved_faces(
@@ -362,34 +362,8 @@ fn evaluate(
     }
     let mut fan: Vec<FanTri> = Vec::with_capacity(12);
     // The faces of v that survive, with v replaced by w at pos.
-    for f in mesh.vertex_faces(v) {
-        let fv = mesh.face_vertices(f);
-        if fv.contains(&w) {
-            continue;
-        }
-        let old = fv.map(|x| mesh.positions[x as usize]);
-        let new = fv.map(|x| {
-            if x == v {
-                pos
-            } else {
-                mesh.positions[x as usize]
-            }
-        });
-        let patch = mesh.face_patch[f as usize];
-        if !face_ok(old, new, star_normal(mesh, v, patch), lim) {
-            return invalid;
-        }
-        fan.push(FanTri {
-            p: new,
-            h: fv.map(|x| {
-                if x == v {
-                    size
-                } else {
-                    mesh.vertex_size[x as usize]
-                }
-            }),
-            patch,
-        });
+    if !moved_faces(mesh, v, w, pos, size, lim, &mut fan) {
+        return invalid;
     }
     let moved = pos != pw;
     if moved && !moved_faces(mesh, w, v, pos, size, lim, &mut fan) {

@@ -218,15 +218,30 @@ pub struct EdgeScore {
     pub y: f64,
 }
 
-/// The half-edge mesh of a target grid with its features and lines.
-struct Setup {
+/// What projections onto a target grid need besides the grid: its features
+/// and feature lines with their end sizes.
+struct TargetParts {
     features: Features,
-    mesh: HalfedgeMesh,
     lines: FeatureLines,
     seg_sizes: Vec<[f64; 2]>,
 }
 
-fn setup(grid: &Grid, params: &SimplifyParams) -> Result<Setup> {
+impl TargetParts {
+    /// The target: `grid` (the grid these parts were made from) with them.
+    fn target<'a>(&'a self, grid: &'a Grid) -> Target<'a> {
+        Target {
+            grid,
+            sizes: grid.sizes().unwrap_or(&[]),
+            face_patch: &self.features.face_patch,
+            lines: &self.lines,
+            seg_sizes: &self.seg_sizes,
+        }
+    }
+}
+
+/// The half-edge mesh of a target grid (sizes, corners and lines set) and
+/// the parts of its target.
+fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetParts)> {
     params.check()?;
     let Some(sizes) = grid.sizes() else {
         return Err(Error::InvalidArgument(
@@ -245,55 +260,40 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<Setup> {
         .iter()
         .map(|s| s.map(|v| mesh.vertex_size[v as usize]))
         .collect();
-    Ok(Setup {
-        features,
+    Ok((
         mesh,
-        lines,
-        seg_sizes,
-    })
+        TargetParts {
+            features,
+            lines,
+            seg_sizes,
+        },
+    ))
 }
 
 /// `(4/√3)∫h⁻²dA` over the live faces with linearly interpolated sizes
 /// (7-point degree-5 rule), summed in face order. O(F).
 fn own_element_count(mesh: &HalfedgeMesh) -> f64 {
-    const RULE: [(f64, f64, f64); 3] = [
-        (1.0 / 3.0, 1.0 / 3.0, 0.225),
-        (
-            0.059_715_871_789_770,
-            0.470_142_064_105_115,
-            0.132_394_152_788_506,
-        ),
-        (
-            0.797_426_985_353_087,
-            0.101_286_507_323_456,
-            0.125_939_180_544_827,
-        ),
-    ];
+    let rule = crate::metrics::quadrature();
     let mut total = 0.0;
     for f in mesh.faces() {
-        let vs = mesh.face_vertices(f);
-        let h = vs.map(|v| mesh.vertex_size[v as usize]);
+        let h = mesh.face_vertices(f).map(|v| mesh.vertex_size[v as usize]);
         let area = 0.5 * crate::geometry::norm(mesh.face_normal2(f));
-        let mut integral = 0.0;
-        for (k, &(a, b, w)) in RULE.iter().enumerate() {
-            let points: &[[f64; 3]] = if k == 0 {
-                &[[a, a, a]]
-            } else {
-                &[[a, b, b], [b, a, b], [b, b, a]]
-            };
-            for p in points {
-                let s = p[0] * h[0] + p[1] * h[1] + p[2] * h[2];
-                integral += w / (s * s);
-            }
-        }
+        let integral: f64 = rule
+            .iter()
+            .map(|(b, w)| {
+                let s = b[0] * h[0] + b[1] * h[1] + b[2] * h[2];
+                w / (s * s)
+            })
+            .sum();
         total += area * integral;
     }
     total * 4.0 / 3f64.sqrt()
 }
 
 /// Simplifies the target grid `grid` (which must carry sizes) by LBO-ABGS.
-/// `progress` is called after every iteration; returning `false` stops the
-/// loop, leaving a valid grid. Errors on invalid parameters or a grid
+/// `progress` is called after every iteration that collapsed something (not
+/// after the final one that found nothing); returning `false` stops the loop,
+/// leaving a valid grid. Errors on invalid parameters or a grid
 /// without sizes. About O(I · (E log E + C · S log F)) for I iterations,
 /// C candidates estimated afresh and S samples per estimate.
 pub fn simplify(
@@ -302,25 +302,14 @@ pub fn simplify(
     mut progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
 ) -> Result<Simplified> {
     let start = Instant::now();
-    let Setup {
-        features,
-        mut mesh,
-        lines,
-        seg_sizes,
-    } = setup(grid, params)?;
-    let target = Target {
-        grid,
-        sizes: grid.sizes().unwrap_or(&[]),
-        face_patch: &features.face_patch,
-        lines: &lines,
-        seg_sizes,
-    };
+    let (mut mesh, parts) = setup(grid, params)?;
+    let target = parts.target(grid);
     let lim = params.limits();
     let flip_lim = repair::flip_limits(&lim, params.feature_angle_deg);
     let mut report = SimplifyReport {
         faces_in: grid.triangles().len(),
         vertices_in: grid.vertices().len(),
-        feature_lines: lines.line_count as usize,
+        feature_lines: parts.lines.line_count as usize,
         corners: mesh
             .vertices()
             .filter(|&v| mesh.vertex_flags[v as usize] & V_CORNER != 0)
@@ -503,19 +492,8 @@ fn finish(mesh: &HalfedgeMesh) -> Result<Grid> {
 /// the labels the learned simplifier is trained on. Edges that are not
 /// manifold in the grid are reported invalid. Parallel; O(E · S log F).
 pub fn edge_scores(grid: &Grid, params: &SimplifyParams) -> Result<Vec<EdgeScore>> {
-    let Setup {
-        features,
-        mesh,
-        lines,
-        seg_sizes,
-    } = setup(grid, params)?;
-    let target = Target {
-        grid,
-        sizes: grid.sizes().unwrap_or(&[]),
-        face_patch: &features.face_patch,
-        lines: &lines,
-        seg_sizes,
-    };
+    let (mesh, parts) = setup(grid, params)?;
+    let target = parts.target(grid);
     let lim = params.limits();
     let topo = grid.topology();
     let mut out: Vec<EdgeScore> = topo

@@ -143,20 +143,20 @@ fn propose(mesh: &HalfedgeMesh, target: &Target, v: u32, lim: &Limits) -> Option
         .map(|t| closest_point_triangle(pv, t.p[0], t.p[1], t.p[2]).dist2)
         .fold(f64::INFINITY, f64::min)
         .sqrt();
-    let mut hint = hit.index;
-    if flags & V_FEATURE == 0 {
-        hint = mesh.vertex_hint[v as usize];
-    }
-    let (ds, dd) = sample_fan(target, &fan, h_loc, lim, 0.5, &mut hint);
+    // A line projection's index is a segment, not a target triangle: feature
+    // vertices keep their triangle hint.
+    let hint = if flags & V_FEATURE == 0 {
+        hit.index
+    } else {
+        mesh.vertex_hint[v as usize]
+    };
+    let mut sample_hint = hint;
+    let (ds, dd) = sample_fan(target, &fan, h_loc, lim, 0.5, &mut sample_hint);
     (score(ds, dd.max(back), h_loc, lim) < 0.5).then_some(Move {
         v,
         p,
         size: hit.size,
-        hint: if flags & V_FEATURE == 0 {
-            hit.index
-        } else {
-            mesh.vertex_hint[v as usize]
-        },
+        hint,
     })
 }
 
@@ -251,7 +251,8 @@ pub fn flip_around(
     touched
 }
 
-/// Cosine helper for the flip limits.
+/// The remesher's flip limits for the simplifier's thresholds: the same
+/// normal turn, creases capped at min(feature angle, 20°).
 pub fn flip_limits(lim: &Limits, feature_angle_deg: f64) -> FlipLimits {
     FlipLimits {
         cos_turn: lim.cos_turn,

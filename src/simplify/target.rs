@@ -33,7 +33,7 @@ pub struct Target<'a> {
     /// Feature lines of the target (segments are target edges).
     pub lines: &'a FeatureLines,
     /// Target sizes at the two ends of each line segment.
-    pub seg_sizes: Vec<[f64; 2]>,
+    pub seg_sizes: &'a [[f64; 2]],
 }
 
 impl Target<'_> {
