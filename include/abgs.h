@@ -373,8 +373,12 @@ typedef struct {
   double seconds_curvature;
   // Seconds for proximity.
   double seconds_proximity;
-  // Seconds for gradation.
+  // Seconds for gradation (with the contact rounds).
   double seconds_gradation;
+  // Vertices lying on another body, whose size is shared with it.
+  uint64_t contact_vertices;
+  // Seconds for finding where bodies touch.
+  double seconds_contacts;
 } abgs_size_report;
 
 #ifdef __cplusplus

@@ -15,6 +15,17 @@ fn params_no_grad() -> SizeParams {
     }
 }
 
+/// Proximity alone, ungraded, hmax 0.5.
+fn proximity_only() -> SizeParams {
+    SizeParams {
+        gradation: None,
+        curvature: false,
+        hmax: Some(0.5),
+        hmin: Some(1e-4),
+        ..Default::default()
+    }
+}
+
 #[test]
 fn sphere_curvature_size_at_three_resolutions() {
     for (r, level) in [(1.0, 2), (3.0, 3), (0.5, 4)] {
@@ -73,14 +84,7 @@ fn two_parallel_plates_gap() {
     s.boxed([0.0, 0.0, gap], [10.0, 10.0, gap + 2.0], 20, false, false);
     let g = s.grid();
     assert_eq!(g.report().bodies, 2);
-    let p = SizeParams {
-        gradation: None,
-        curvature: false,
-        hmax: Some(0.5),
-        hmin: Some(1e-4),
-        ..Default::default()
-    };
-    let f = sizing::compute(&g, &p).unwrap();
+    let f = sizing::compute(&g, &proximity_only()).unwrap();
     let expect = gap / 3.0;
     for (i, v) in g.vertices().iter().enumerate() {
         let facing_gap = v[2] == 0.0 || v[2] == gap;
@@ -99,6 +103,49 @@ fn two_parallel_plates_gap() {
             );
             assert_eq!(f.h0[i], 0.5);
         }
+    }
+}
+
+#[test]
+fn touching_bodies_share_the_smaller_size_on_their_interface() {
+    // A thin plate (0.1 thick: proximity size 0.1/3) lying on a big block whose
+    // top would otherwise take hmax; their vertices do not coincide.
+    let mut s = Soup::default();
+    s.boxed([0.0, 0.0, -2.0], [10.0, 10.0, 0.0], 20, false, false);
+    s.boxed([3.1, 3.1, 0.0], [6.9, 6.9, 0.1], 8, false, false);
+    let mut g = s.grid();
+    assert_eq!(g.report().bodies, 2);
+    let f = sizing::compute(&g, &proximity_only()).unwrap();
+    let plate = 0.1 / 3.0;
+    let inside = |x: f64| x > 3.1 + 1e-9 && x < 6.9 - 1e-9;
+    let mut shared = 0;
+    for (i, v) in g.vertices().iter().enumerate() {
+        let on_block_top =
+            v[2] == 0.0 && (v[0] <= 3.1 || v[0] >= 6.9 || v[1] <= 3.1 || v[1] >= 6.9);
+        if v[2] == 0.0 && inside(v[0]) && inside(v[1]) {
+            // Block top under the plate (the plate's own bottom vertices are
+            // all on its rim, outside this open square).
+            assert!(
+                (f.h0[i] / plate - 1.0).abs() < 0.1,
+                "vertex {i} {v:?}: {}",
+                f.h0[i]
+            );
+            shared += 1;
+        } else if on_block_top && (v[0] < 3.0 || v[0] > 7.0 || v[1] < 3.0 || v[1] > 7.0) {
+            assert_eq!(f.h0[i], 0.5, "vertex {i} {v:?} away from the plate");
+        }
+    }
+    assert!(shared >= 49, "{shared} block vertices under the plate");
+    assert!(f.report.contact_vertices >= shared);
+    // A query on the interface answers the plate's size whichever body it
+    // lands on (a block cell away from the plate's rim, where the block's
+    // triangles straddle it).
+    g.set_sizes(f.h.clone()).unwrap();
+    for k in 0..50 {
+        let x = 3.6 + 2.8 * (k as f64 * 0.618_033_988_75).fract();
+        let y = 3.6 + 2.8 * (k as f64 * 0.414_213_562_37).fract();
+        let h = g.closest([x, y, 0.0], None).unwrap().size;
+        assert!((h / plate - 1.0).abs() < 0.1, "({x}, {y}): {h}");
     }
 }
 

@@ -178,6 +178,7 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
             "input_faces": surface.triangles().len(),
             "dense_faces": dense.triangles().len(),
             "dense_vertices": dense.vertices().len(),
+            "contact_vertices": fields.report.contact_vertices,
             "simplified_faces": simplified.grid.triangles().len(),
             "simplified_vertices": simplified.grid.vertices().len(),
         },

@@ -152,6 +152,12 @@ pub fn run(input: &Path, output: &Path, args: &SizeArgs) -> Result<()> {
         r.gradation.max_slope_ratio_before_fix,
         r.gradation.max_slope_ratio
     );
+    if r.contact_vertices > 0 {
+        eprintln!(
+            "touching bodies: {} vertices share their size with another body",
+            r.contact_vertices
+        );
+    }
     let (lo, hi) =
         f.h.iter()
             .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));

@@ -96,8 +96,12 @@ pub struct abgs_size_report {
     pub seconds_curvature: f64,
     /// Seconds for proximity.
     pub seconds_proximity: f64,
-    /// Seconds for gradation.
+    /// Seconds for gradation (with the contact rounds).
     pub seconds_gradation: f64,
+    /// Vertices lying on another body, whose size is shared with it.
+    pub contact_vertices: u64,
+    /// Seconds for finding where bodies touch.
+    pub seconds_contacts: f64,
 }
 
 /// Writes the default parameters into `*out_params`.
@@ -236,6 +240,8 @@ pub unsafe extern "C" fn abgs_compute_size(
                 seconds_curvature: r.seconds_curvature,
                 seconds_proximity: r.seconds_proximity,
                 seconds_gradation: r.seconds_gradation,
+                contact_vertices: r.contact_vertices as u64,
+                seconds_contacts: r.seconds_contacts,
             };
         }
         Ok(())

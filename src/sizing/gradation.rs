@@ -531,7 +531,8 @@ fn project_ellipse(a: [f64; 3], y: [f64; 2], t: f64) -> [f64; 2] {
 }
 
 /// New values of a face steeper than `t`: its smallest corner stays, the other
-/// two are lowered as little as possible (L2) to slope `t`, never raised. O(1).
+/// two are lowered as little as possible (L2) to slope `t`, never raised and
+/// never below the smallest corner. O(1).
 fn lower_face(p: [[f64; 3]; 3], h: [f64; 3], t: f64) -> [f64; 3] {
     let m = (0..3).fold(0, |m, k| if h[k] < h[m] { k } else { m });
     let (b, c) = ((m + 1) % 3, (m + 2) % 3);
@@ -552,6 +553,20 @@ fn lower_face(p: [[f64; 3]; 3], h: [f64; 3], t: f64) -> [f64; 3] {
         r = other(r0[0], minv[0], minv[2]).map_or([0.0; 2], |y| [r0[0], y]);
     } else if r[1] > r0[1] {
         r = other(r0[1], minv[2], minv[0]).map_or([0.0; 2], |x| [x, r0[1]]);
+    }
+    // Nothing below the smallest corner: on a sliver the projection can send a
+    // corner far below it (below zero with large sizes). That corner then
+    // takes the smallest value and the other the largest admissible one.
+    if r[0] < 0.0 {
+        r = [
+            0.0,
+            other(0.0, minv[0], minv[2]).map_or(0.0, |y| y.clamp(0.0, r0[1])),
+        ];
+    } else if r[1] < 0.0 {
+        r = [
+            other(0.0, minv[2], minv[0]).map_or(0.0, |x| x.clamp(0.0, r0[0])),
+            0.0,
+        ];
     }
     let mut out = h;
     out[b] = h[b].min(h[m] + r[0]);

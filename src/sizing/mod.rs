@@ -5,6 +5,7 @@
 //! Stages and costs: features O(F); curvature O(V·ring), proximity O(V log F)
 //! (both parallel); gradation O(V log V) (sequential, Dijkstra-ordered).
 
+pub mod contact;
 pub mod curvature;
 pub mod gradation;
 pub mod lbo;
@@ -21,6 +22,11 @@ use crate::error::{Error, Result};
 use crate::mesh::{Features, Grid};
 use std::f64::consts::PI;
 use std::time::Instant;
+
+/// Most rounds of (share sizes at contacts, grade again) after the first gradation.
+const CONTACT_ROUNDS: usize = 4;
+/// A contact size lowered by less than this (relative) does not call for another round.
+const CONTACT_REL: f64 = 1e-3;
 
 /// How gradation is specified.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,7 +75,8 @@ pub struct SizeParams {
     pub sources: Vec<SizeSource>,
     /// Gaps narrower than this are contacts (touching parts, tessellation noise
     /// between coincident curved faces), not gaps; `None` = hmin. A gap below
-    /// hmin cannot be resolved by the field anyway.
+    /// hmin cannot be resolved by the field anyway. Where two bodies touch,
+    /// both take the smaller of their sizes (see [`contact`]).
     pub contact_gap: Option<f64>,
 }
 
@@ -173,13 +180,18 @@ pub struct SizeReport {
     pub limited_by: LimitCounts,
     /// Gradation report (default when off).
     pub gradation: GradationReport,
+    /// Vertices lying on another body (within the contact gap), whose size is
+    /// shared with it (see [`contact`]).
+    pub contact_vertices: usize,
     /// Seconds: features and patch normals.
     pub seconds_features: f64,
     /// Seconds: curvature.
     pub seconds_curvature: f64,
     /// Seconds: proximity.
     pub seconds_proximity: f64,
-    /// Seconds: gradation.
+    /// Seconds: finding the vertices where bodies touch.
+    pub seconds_contacts: f64,
+    /// Seconds: gradation (with the contact rounds).
     pub seconds_gradation: f64,
 }
 
@@ -188,7 +200,7 @@ pub struct SizeReport {
 pub struct SizeFields {
     /// Final sizes (graded H0, or H0 when gradation is off).
     pub h: Vec<f64>,
-    /// Initial sizes after clamping.
+    /// Initial sizes after clamping, shared where bodies touch.
     pub h0: Vec<f64>,
     /// Curvature sizes `2π/(κ n_circle)` (`+inf` where flat or off).
     pub h_curv: Vec<f64>,
@@ -238,10 +250,10 @@ pub fn compute(grid: &Grid, params: &SizeParams) -> Result<SizeFields> {
     };
     report.seconds_curvature = t.elapsed().as_secs_f64();
 
+    let contact_gap = params.contact_gap.unwrap_or(hmin).max(1e-12 * diag);
     let t = Instant::now();
     let h_prox: Vec<f64> = if params.proximity {
-        let contact = params.contact_gap.unwrap_or(hmin).max(1e-12 * diag);
-        let g = proximity::gaps(grid, &normals, contact, hmax * params.n_gap);
+        let g = proximity::gaps(grid, &normals, contact_gap, hmax * params.n_gap);
         g.into_iter().map(|g| g / params.n_gap).collect()
     } else {
         vec![f64::INFINITY; nv]
@@ -283,17 +295,41 @@ pub fn compute(grid: &Grid, params: &SizeParams) -> Result<SizeFields> {
         h0[i] = best.0.clamp(hmin, hmax);
     }
 
+    // Touching bodies agree on their interface (the smaller size), before and
+    // after gradation, until gradation no longer separates them.
+    let t = Instant::now();
+    let contacts = contact::contacts(grid, contact_gap);
+    report.contact_vertices = contacts.len();
+    contact::unify(&mut h0, grid.triangles(), &contacts, 0.0);
+    report.seconds_contacts = t.elapsed().as_secs_f64();
+
     let t = Instant::now();
     let h = match slope {
         Some(s) => {
-            let (h, r) =
-                gradation::grade(grid.vertices(), grid.triangles(), grid.topology(), &h0, s);
+            let grade = |h: &[f64]| {
+                gradation::grade(grid.vertices(), grid.triangles(), grid.topology(), h, s)
+            };
+            let (mut h, mut r) = grade(&h0);
+            for _ in 0..CONTACT_ROUNDS {
+                if contact::unify(&mut h, grid.triangles(), &contacts, CONTACT_REL) == 0 {
+                    break;
+                }
+                (h, r) = grade(&h);
+            }
             report.gradation = r;
             h
         }
         None => h0.clone(),
     };
     report.seconds_gradation = t.elapsed().as_secs_f64();
+    // Every stage keeps sizes within [min H0, H0]; a violation is a bug, and
+    // an error rather than a field no mesher could use.
+    if let Some(i) = h.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
+        return Err(Error::InvalidSize(format!(
+            "internal error: vertex {i} got size {} (please report it with the model)",
+            h[i]
+        )));
+    }
     Ok(SizeFields {
         h,
         h0,

@@ -152,10 +152,34 @@ impl Bvh {
         hint: Option<u32>,
         keep: impl Fn(u32) -> bool,
     ) -> Option<ClosestHit> {
+        self.search(p, hint, f64::INFINITY, keep)
+    }
+
+    /// [`Bvh::closest_filtered`] restricted to distances below `max_distance`
+    /// (`None` when no accepted triangle is that close). Only the nodes within
+    /// `max_distance` of `p` are visited: O(log F + k) for a small radius with
+    /// k triangles inside it.
+    pub fn closest_filtered_within(
+        &self,
+        p: [f64; 3],
+        max_distance: f64,
+        keep: impl Fn(u32) -> bool,
+    ) -> Option<ClosestHit> {
+        self.search(p, None, max_distance * max_distance, keep)
+    }
+
+    /// Branch and bound from the bound `bound2` (squared distance), seeded by `hint`.
+    fn search(
+        &self,
+        p: [f64; 3],
+        hint: Option<u32>,
+        bound2: f64,
+        keep: impl Fn(u32) -> bool,
+    ) -> Option<ClosestHit> {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best_d2 = f64::INFINITY;
+        let mut best_d2 = bound2;
         let mut best_tri = u32::MAX;
         let mut best_cp = ClosestPoint {
             point: p,
@@ -166,9 +190,12 @@ impl Bvh {
             // In range first: `keep` may index by triangle.
             if let Some(&slot) = self.triangle_prim.get(h as usize).filter(|_| keep(h)) {
                 let c = &self.prim_corners[slot as usize];
-                best_cp = closest_point_triangle(p, c[0], c[1], c[2]);
-                best_d2 = best_cp.dist2;
-                best_tri = h;
+                let cp = closest_point_triangle(p, c[0], c[1], c[2]);
+                if cp.dist2 < best_d2 {
+                    best_d2 = cp.dist2;
+                    best_cp = cp;
+                    best_tri = h;
+                }
             }
         }
         let mut stack = [(0u32, 0f64); MAX_DEPTH];
