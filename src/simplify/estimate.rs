@@ -144,12 +144,14 @@ pub fn sample_fan(
                 } else {
                     f64::INFINITY
                 };
-                ds = ds.max(r);
-                dd = dd.max(hit.dist);
+                if r > ds || hit.dist > dd {
+                    ds = ds.max(r);
+                    dd = dd.max(hit.dist);
+                    if score(ds, dd, h_loc, lim) >= exit_at {
+                        return (ds, dd);
+                    }
+                }
             }
-        }
-        if score(ds, dd, h_loc, lim) >= exit_at {
-            break;
         }
     }
     (ds, dd)
