@@ -11,14 +11,22 @@
 // then barycentric interpolation of the vertex sizes on that triangle (double).
 // abgs: abgs_query_size (plain), abgs_query_size_hinted (one hint carried along
 // the sequence), abgs_query_sizes (batch, rayon). Every abgs answer must agree
-// with CGAL's to `tolerance` relative (default 1e-9): the sizes are continuous
-// (per-vertex linear), so equidistant ties between triangles give equal values.
+// with CGAL's to `tolerance` relative (default 1e-9). The sizes are continuous
+// (per-vertex linear) on one body, so equidistant ties between triangles of one
+// body give equal values; where two bodies have coincident faces (touching or
+// overlapping solids, e.g. abc_00000050) the field is two-valued, and the two
+// libraries may pick different nearest triangles at the same distance. Every
+// mismatch is therefore re-examined: all triangles within 1e-12 x diagonal of the
+// nearest distance are collected (CGAL all_intersected_primitives + projection)
+// and a mismatch is a *tie* when every answer (CGAL's and abgs') is the
+// interpolation on one of them; ties are counted (and those across bodies), the
+// rest are *unexplained* and fail the check.
 //
 // Prints progress on stderr and one JSON object on stdout: queries/s single
 // thread (CGAL plain and hinted, abgs plain and hinted) and all threads (CGAL
 // with std::thread, abgs batch, abgs hinted with one hint per thread), build
 // times, and the agreement. Timings are the best of R repetitions.
-// Exit status: 0 agreement, 1 disagreement, 2 error.
+// Exit status: 0 agreement (ties allowed), 1 an unexplained mismatch, 2 error.
 #include "harness.hpp"
 
 #include <CGAL/AABB_traits.h>
@@ -57,6 +65,36 @@ struct CgalSizer {
         tree.insert(tris.cbegin(), tris.cend());
         tree.build();
         tree.accelerate_distance_queries();
+        // Bodies: triangles connected through shared vertices (union-find).
+        std::vector<uint32_t> parent(g.vertices());
+        for (size_t i = 0; i < parent.size(); i++) parent[i] = static_cast<uint32_t>(i);
+        auto find = [&](uint32_t x) {
+            while (parent[x] != x) x = parent[x] = parent[parent[x]];
+            return x;
+        };
+        for (size_t f = 0; f < g.triangles(); f++)
+            for (int k = 1; k < 3; k++) parent[find(g.tri[3 * f + k])] = find(g.tri[3 * f]);
+        body.resize(g.triangles());
+        for (size_t f = 0; f < g.triangles(); f++) body[f] = find(g.tri[3 * f]);
+    }
+    std::vector<uint32_t> body;  // a representative vertex per triangle's body
+
+    /// The interpolated sizes on every triangle within `eps` of the nearest
+    /// distance to `p` (the candidates of an equidistant tie), with the triangles.
+    std::vector<std::pair<double, size_t>> tie_candidates(const Point &p, double eps) const {
+        Hint h = tree.closest_point_and_primitive(p);
+        const double d = std::sqrt(CGAL::squared_distance(h.first, p)) + eps;
+        CGAL::Bbox_3 box(p.x() - d, p.y() - d, p.z() - d, p.x() + d, p.y() + d, p.z() + d);
+        std::vector<TriIt> prims;
+        tree.all_intersected_primitives(box, std::back_inserter(prims));
+        K::Construct_projected_point_3 project;
+        std::vector<std::pair<double, size_t>> out;
+        for (TriIt it : prims) {
+            Point q = project(*it, p);
+            size_t f = static_cast<size_t>(it - tris.cbegin());
+            if (std::sqrt(CGAL::squared_distance(q, p)) <= d) out.emplace_back(interpolate(f, q), f);
+        }
+        return out;
     }
     /// Barycentric interpolation of the vertex sizes of triangle `f` at `q`
     /// (a point on it), coordinates clamped to the triangle.
@@ -227,31 +265,55 @@ int main(int argc, char **argv) {
             });
         });
 
-        // Agreement: every abgs answer against CGAL's plain answer.
-        double max_rel = 0.0;
-        size_t bad = 0;
+        // Agreement: every answer (abgs' and CGAL's hinted / threaded) against
+        // CGAL's plain one; mismatches re-examined for equidistant ties.
+        double max_rel = 0.0, max_rel_untied = 0.0;
+        size_t bad = 0, ties = 0, ties_bodies = 0, unexplained = 0;
         auto rel = [&](double a, double b) { return std::fabs(a - b) / std::fabs(b); };
+        const double eps = 1e-12 * g.stats.diagonal;
         for (size_t i = 0; i < n; i++) {
-            double r = std::max({rel(plain[i], ref[i]), rel(hinted[i], ref[i]), rel(batch[i], ref[i]),
-                                 rel(hinted_mt[i], ref[i]), rel(ref_h[i], ref[i]), rel(cgal_mt[i], ref[i])});
-            if (!(r <= tol)) {
-                if (bad < 5) {
-                    abgs_hit hit;
-                    check(abgs_query_closest(g.g, &pts[3 * i], ABGS_NO_HINT, &hit), "abgs_query_closest");
-                    Hint h = cg.tree.closest_point_and_primitive(cpts[i]);
-                    std::fprintf(stderr,
-                                 "  %s point %zu (%.17g %.17g %.17g): CGAL %.17g (triangle %zu, distance %.17g), "
-                                 "abgs %.17g / hinted %.17g / batch %.17g (triangle %u, distance %.17g)\n",
-                                 kind, i, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], ref[i],
-                                 static_cast<size_t>(h.second - cg.tris.cbegin()),
-                                 std::sqrt(CGAL::squared_distance(h.first, cpts[i])), plain[i], hinted[i], batch[i],
-                                 hit.triangle, hit.distance);
-                }
-                bad++;
+            const double answers[] = {ref[i], plain[i], hinted[i], batch[i], hinted_mt[i], ref_h[i], cgal_mt[i]};
+            double r = 0.0;
+            for (double a : answers) r = std::max(r, std::isnan(a) ? INFINITY : rel(a, ref[i]));
+            max_rel = std::max(max_rel, r);
+            if (r <= tol) continue;
+            bad++;
+            auto cand = cg.tie_candidates(cpts[i], eps);
+            bool explained = true, bodies = false;
+            for (double a : answers) {
+                bool found = false;
+                for (const auto &c : cand) found = found || rel(a, c.first) <= tol;
+                explained = explained && found;
             }
-            if (r > max_rel || std::isnan(r)) max_rel = std::isnan(r) ? INFINITY : r;
+            for (const auto &c : cand) bodies = bodies || cg.body[c.second] != cg.body[cand[0].second];
+            if (explained) {
+                ties++;
+                ties_bodies += bodies;
+                if (ties <= 2) {
+                    std::fprintf(stderr, "  %s point %zu: tie, %zu triangles at the nearest distance:", kind, i,
+                                 cand.size());
+                    for (const auto &c : cand)
+                        std::fprintf(stderr, " %zu (body %u) %.9g;", c.second, cg.body[c.second], c.first);
+                    std::fprintf(stderr, " CGAL %.17g, abgs %.17g\n", ref[i], plain[i]);
+                }
+                continue;
+            }
+            unexplained++;
+            max_rel_untied = std::max(max_rel_untied, r);
+            if (unexplained <= 5) {
+                abgs_hit hit;
+                check(abgs_query_closest(g.g, &pts[3 * i], ABGS_NO_HINT, &hit), "abgs_query_closest");
+                Hint h = cg.tree.closest_point_and_primitive(cpts[i]);
+                std::fprintf(stderr,
+                             "  %s point %zu (%.17g %.17g %.17g): CGAL %.17g (triangle %zu, distance %.17g), "
+                             "abgs %.17g / hinted %.17g / batch %.17g (triangle %u, distance %.17g)\n",
+                             kind, i, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], ref[i],
+                             static_cast<size_t>(h.second - cg.tris.cbegin()),
+                             std::sqrt(CGAL::squared_distance(h.first, cpts[i])), plain[i], hinted[i], batch[i],
+                             hit.triangle, hit.distance);
+            }
         }
-        all_agree = all_agree && bad == 0;
+        all_agree = all_agree && unexplained == 0;
         std::string k = kind;
         double q = static_cast<double>(n);
         out.num(k + "_cgal_qps", q / t_cgal)
@@ -262,12 +324,18 @@ int main(int argc, char **argv) {
             .num(k + "_abgs_batch_qps", q / t_batch)
             .num(k + "_abgs_hinted_mt_qps", q / t_hinted_mt)
             .num(k + "_max_rel_diff", max_rel)
-            .num(k + "_mismatches", static_cast<double>(bad));
+            .num(k + "_max_rel_diff_untied", max_rel_untied)
+            .num(k + "_mismatches", static_cast<double>(bad))
+            .num(k + "_ties", static_cast<double>(ties))
+            .num(k + "_ties_across_bodies", static_cast<double>(ties_bodies))
+            .num(k + "_unexplained", static_cast<double>(unexplained));
         std::fprintf(stderr,
                      "%-8s 1 thread: CGAL %.3g q/s (hinted %.3g), abgs %.3g q/s (x%.1f), hinted %.3g (x%.1f); "
-                     "%u threads: CGAL %.3g, abgs batch %.3g (x%.1f), hinted %.3g; max rel diff %.2g, %zu over %.0e\n",
+                     "%u threads: CGAL %.3g, abgs batch %.3g (x%.1f), hinted %.3g; max rel diff %.2g, %zu over %.0e "
+                     "(%zu equidistant ties, %zu of them across bodies; %zu unexplained)\n",
                      kind, q / t_cgal, q / t_cgal_h, q / t_plain, t_cgal / t_plain, q / t_hinted, t_cgal / t_hinted,
-                     threads, q / t_cgal_mt, q / t_batch, t_cgal_mt / t_batch, q / t_hinted_mt, max_rel, bad, tol);
+                     threads, q / t_cgal_mt, q / t_batch, t_cgal_mt / t_batch, q / t_hinted_mt, max_rel, bad, tol,
+                     ties, ties_bodies, unexplained);
     }
     out.num("tolerance", tol).boolean("agree", all_agree).print();
     if (!all_agree) std::fprintf(stderr, "compare_queries: abgs and CGAL disagree beyond %.0e\n", tol);
