@@ -78,8 +78,9 @@ echo "gmsh: $lib; CGAL $(sed -n 's/^#define CGAL_VERSION \(.*\)$/\1/p' /usr/incl
 
 # --- build ---------------------------------------------------------------------
 step "build: abgs library and CLI, then the harness"
-cargo build --release --lib
-cargo build --release -p abgs-cli --bin abgs
+# The library and the CLI in one build (features unified as in `cargo build
+# --release --workspace`, so neither is rebuilt twice).
+cargo build --release --workspace --lib --bin abgs
 abgs=$repo/target/release/abgs
 cmake -S cmake/harness -B "$work/build" -Dabgs_DIR="$repo/cmake" -DGMSH_ROOT="$venv" \
   -DCMAKE_BUILD_TYPE=Release > "$work/cmake-configure.log" || { cat "$work/cmake-configure.log"; exit 2; }

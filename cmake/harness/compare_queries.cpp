@@ -276,7 +276,10 @@ int main(int argc, char **argv) {
             double r = 0.0;
             for (double a : answers) r = std::max(r, std::isnan(a) ? INFINITY : rel(a, ref[i]));
             max_rel = std::max(max_rel, r);
-            if (r <= tol) continue;
+            if (r <= tol) {
+                max_rel_untied = std::max(max_rel_untied, r);
+                continue;
+            }
             bad++;
             auto cand = cg.tie_candidates(cpts[i], eps);
             bool explained = true, bodies = false;
