@@ -9,8 +9,8 @@
 //                   graded on the STL vertices (abgs_compute_size, defaults, as
 //                   `abgs run` uses on the dense grid)
 //   (d) postview    no callback: the dense grid written by abgs_grid_save as MSH
-//                   with its sizes as $NodeData, merged into its own model and
-//                   used as a PostView background field
+//                   (one $NodeData view per point array), merged into its own
+//                   model; the view named "size" is a PostView background field
 // Mesh.MeshSizeFromPoints, MeshSizeFromCurvature and MeshSizeExtendFromBoundary
 // are 0 in every case. The callback keeps one hint per thread and counts calls
 // and the time spent inside it (atomics: Gmsh may call it from several threads;
@@ -278,12 +278,20 @@ int main(int argc, char **argv) {
             size_t tags_n = 0;
             gmshViewGetTags(&tags, &tags_n, &ierr);
             gcheck(ierr, "gmshViewGetTags");
-            if (tags_n != 1) {
-                std::fprintf(stderr, "expected one view in %s, got %zu\n", msh.c_str(), tags_n);
+            // One view per point array of the grid: take the one named "size".
+            int view = -1;
+            for (size_t i = 0; i < tags_n && view < 0; i++) {
+                char *name = nullptr;
+                gmshViewOptionGetString(tags[i], "Name", &name, &ierr);
+                gcheck(ierr, "gmshViewOptionGetString");
+                if (name && std::string(name) == "size") view = tags[i];
+                gmshFree(name);
+            }
+            gmshFree(tags);
+            if (view < 0) {
+                std::fprintf(stderr, "no view named \"size\" among the %zu of %s\n", tags_n, msh.c_str());
                 return 2;
             }
-            const int view = tags[0];
-            gmshFree(tags);
             setup = now() - t0;
             import_step(step);
             int field = gmshModelMeshFieldAdd("PostView", -1, &ierr);
