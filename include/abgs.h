@@ -134,6 +134,77 @@ typedef struct {
   uint64_t memory_bytes;
 } abgs_grid_stats;
 
+// Parameters of `abgs_evaluate`; get the defaults from `abgs_eval_params_default`.
+typedef struct {
+  // Points sampled uniformly on the reference for the size deviation, > 0
+  // (default 100 000).
+  uint64_t samples;
+  // Points sampled on each surface for the Hausdorff distance (every vertex
+  // is added to them), > 0 (default 100 000).
+  uint64_t hausdorff_samples;
+  // Seed of every sampling (default 1).
+  uint64_t seed;
+} abgs_eval_params;
+
+// Smallest and largest angle per face of a grid, in degrees (percentiles by
+// nearest rank).
+typedef struct {
+  // Smallest angle of the grid.
+  double min;
+  // 1st percentile of the per-face smallest angle.
+  double min_p1;
+  // 5th percentile of the per-face smallest angle.
+  double min_p5;
+  // 99th percentile of the per-face largest angle.
+  double max_p99;
+  // Largest angle of the grid.
+  double max;
+  // Mean of the per-face smallest angle.
+  double mean_min;
+} abgs_angle_stats;
+
+// What `abgs_evaluate` measured: a candidate grid against its reference.
+typedef struct {
+  // Faces of the reference.
+  uint64_t faces_reference;
+  // Faces of the candidate.
+  uint64_t faces_candidate;
+  // Vertices of the reference.
+  uint64_t vertices_reference;
+  // Vertices of the candidate.
+  uint64_t vertices_candidate;
+  // `1 − faces_candidate / faces_reference`.
+  double reduction;
+  // Mean of the size ratio `max(h_c/h_r, h_r/h_c)` (>= 1; 1 = equal sizes)
+  // at points sampled uniformly on the reference.
+  double size_deviation_mean;
+  // 95th percentile of that ratio (nearest rank).
+  double size_deviation_p95;
+  // Largest ratio.
+  double size_deviation_max;
+  // Number of points the ratio was measured at.
+  uint64_t size_deviation_samples;
+  // Symmetric sampled Hausdorff distance between the surfaces (model units).
+  double hausdorff;
+  // `hausdorff / diagonal`.
+  double hausdorff_relative;
+  // Bounding-box diagonal of the reference.
+  double diagonal;
+  // Estimated element count `(4/√3) ∫ h⁻² dA` over the reference with the
+  // reference's own sizes.
+  double element_count_reference;
+  // The same integral over the reference with the candidate's sizes (surface queries).
+  double element_count_candidate;
+  // `element_count_candidate / element_count_reference − 1`.
+  double element_count_change;
+  // Angles of the reference.
+  abgs_angle_stats angles_reference;
+  // Angles of the candidate.
+  abgs_angle_stats angles_candidate;
+  // Wall time of the evaluation, seconds.
+  double seconds;
+} abgs_evaluation;
+
 // Answer of `abgs_query_closest`.
 typedef struct {
   // Triangle holding the closest point.
@@ -505,6 +576,67 @@ abgs_status abgs_grid_copy_sizes(const abgs_grid *grid, double *out_sizes, size_
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
 // number of elements; a grid pointer comes from this library and is not freed.
 abgs_status abgs_grid_free(abgs_grid *grid);
+
+// Writes the default parameters into `*out_params` (100 000 samples for the
+// size deviation and for each side of the Hausdorff distance, seed 1).
+//
+// # Safety
+// `out_params` is NULL (reported) or writable.
+abgs_status abgs_eval_params_default(abgs_eval_params *out_params);
+
+// Evaluates `candidate` (e.g. a simplified grid) against `reference` (the
+// dense grid it came from): reduction, size deviation, symmetric Hausdorff
+// distance, estimated element counts and angles (see `abgs_evaluation`), the
+// same numbers as `abgs eval`. Both grids need sizes. Parallel on the rayon
+// pool, deterministic (the same bits whatever the thread count).
+// O(F_r log F_c + (n + V_r) log F_c + (m + V_c) log F_r + F log F) for n size
+// samples and m Hausdorff samples; the 7 candidate queries per reference face
+// of the element count dominate on dense references.
+//
+// Errors: NULL, INVALID_ARGUMENT (a sample count of 0), NO_SIZES, INVALID_SIZE
+// (a size met that is not finite and > 0), BUSY.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid; grid pointers
+// come from this library and are not freed.
+abgs_status abgs_evaluate(const abgs_grid *reference,
+                          const abgs_grid *candidate,
+                          const abgs_eval_params *params,
+                          abgs_evaluation *out_evaluation);
+
+// Symmetric Hausdorff distance between the surfaces of `a` and `b` into
+// `*out_distance`: the larger of the two one-sided distances of
+// `abgs_hausdorff_directed` (each from `samples` area-uniform points with
+// `seed`, plus every vertex, measured exactly to the other surface). The value
+// `abgs_evaluate` reports as `hausdorff`. Sizes are not needed. Parallel,
+// deterministic. O((samples + V_a) log F_b + (samples + V_b) log F_a).
+//
+// Errors: NULL, INVALID_ARGUMENT (`samples` is 0), BUSY.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid; grid pointers
+// come from this library and are not freed.
+abgs_status abgs_hausdorff(const abgs_grid *a,
+                           const abgs_grid *b,
+                           uint64_t samples,
+                           uint64_t seed,
+                           double *out_distance);
+
+// One-sided Hausdorff distance from the surface of `from` to that of `to` into
+// `*out_distance`: the largest exact distance to `to` over `samples`
+// area-uniform points of `from` (with `seed`) and every vertex of `from`.
+// Sizes are not needed. Parallel, deterministic. O((samples + V_from) log F_to).
+//
+// Errors: NULL, INVALID_ARGUMENT (`samples` is 0), BUSY.
+//
+// # Safety
+// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid; grid pointers
+// come from this library and are not freed.
+abgs_status abgs_hausdorff_directed(const abgs_grid *from,
+                                    const abgs_grid *to,
+                                    uint64_t samples,
+                                    uint64_t seed,
+                                    double *out_distance);
 
 // Size at `point` (3 doubles): exact closest point on the grid, barycentric
 // interpolation there. Expected O(log F).

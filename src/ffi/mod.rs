@@ -15,6 +15,7 @@
 
 mod boundary;
 mod grid;
+mod metrics;
 mod query;
 mod remesh;
 mod simplify;
@@ -22,6 +23,7 @@ mod sizing;
 
 pub use boundary::*;
 pub use grid::*;
+pub use metrics::*;
 pub use query::*;
 pub use remesh::*;
 pub use simplify::*;

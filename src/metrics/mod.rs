@@ -338,33 +338,42 @@ pub fn angle_stats(grid: &Grid) -> AngleStats {
 
 /// Symmetric Hausdorff distance between two surfaces, from `n` area-uniform
 /// samples on each (plus every vertex), measured exactly through each grid's
-/// BVH. Deterministic (a maximum). O((n + V) log F).
+/// BVH: the larger of the two [`hausdorff_directed`] values. Deterministic (a
+/// maximum). O((n + V) log F).
 pub fn hausdorff(a: &Grid, b: &Grid, n: usize, seed: u64) -> f64 {
-    let one = |x: &Grid, y: &Grid| {
-        let mut pts: Vec<[f64; 3]> = surface_points(x, n, seed)
-            .into_iter()
-            .map(|s| s.1)
-            .collect();
-        pts.extend_from_slice(x.vertices());
-        let pts: Vec<[f64; 3]> = morton_order(&pts)
-            .into_iter()
-            .map(|i| pts[i as usize])
-            .collect();
-        pts.par_chunks(SAMPLE_CHUNK)
-            .map(|c| {
-                let mut hint = None;
-                let mut m: f64 = 0.0;
-                for &p in c {
-                    if let Some(h) = y.bvh().closest(p, hint) {
-                        m = m.max(h.closest.dist2.sqrt());
-                        hint = Some(h.triangle);
-                    }
+    hausdorff_directed(a, b, n, seed).max(hausdorff_directed(b, a, n, seed))
+}
+
+/// One-sided Hausdorff distance from `from` to `to`: the largest exact distance
+/// to `to` (through its BVH) over `n` area-uniform samples of `from` (with
+/// `seed`) and every vertex of `from`. 0 when `from` has no triangles.
+/// Deterministic (a maximum). O((n + V_from) log F_to).
+pub fn hausdorff_directed(from: &Grid, to: &Grid, n: usize, seed: u64) -> f64 {
+    if from.triangles().is_empty() {
+        return 0.0;
+    }
+    let mut pts: Vec<[f64; 3]> = surface_points(from, n, seed)
+        .into_iter()
+        .map(|s| s.1)
+        .collect();
+    pts.extend_from_slice(from.vertices());
+    let pts: Vec<[f64; 3]> = morton_order(&pts)
+        .into_iter()
+        .map(|i| pts[i as usize])
+        .collect();
+    pts.par_chunks(SAMPLE_CHUNK)
+        .map(|c| {
+            let mut hint = None;
+            let mut m: f64 = 0.0;
+            for &p in c {
+                if let Some(h) = to.bvh().closest(p, hint) {
+                    m = m.max(h.closest.dist2.sqrt());
+                    hint = Some(h.triangle);
                 }
-                m
-            })
-            .reduce(|| 0.0, f64::max)
-    };
-    one(a, b).max(one(b, a))
+            }
+            m
+        })
+        .reduce(|| 0.0, f64::max)
 }
 
 /// Indices of `points` in Z-order (Morton order on a 2²¹ lattice over their

@@ -1,0 +1,346 @@
+// compare_queries GRID [--points N] [--reps R] [--seed S] [--tolerance T]
+//
+// Size queries on one grid with sizes (e.g. dense.vtk or simplified.vtk from
+// `abgs run`), CGAL against abgs, on three point sets of N points each (fixed
+// seed): "near" (surface samples moved along the normal by up to 1 % of the
+// diagonal), "uniform" (the bounding box) and "walk" (a coherent front-like walk:
+// steps of half the local size along a slowly turning direction, projected back
+// onto the surface, plus a small off-surface jitter, restarted every 2000 steps).
+//
+// CGAL: AABB_tree over the triangle list (Epick), closest_point_and_primitive,
+// then barycentric interpolation of the vertex sizes on that triangle (double).
+// abgs: abgs_query_size (plain), abgs_query_size_hinted (one hint carried along
+// the sequence), abgs_query_sizes (batch, rayon). Every abgs answer must agree
+// with CGAL's to `tolerance` relative (default 1e-9). The sizes are continuous
+// (per-vertex linear) on one body, so equidistant ties between triangles of one
+// body give equal values; where two bodies have coincident faces (touching or
+// overlapping solids, e.g. abc_00000050) the field is two-valued, and the two
+// libraries may pick different nearest triangles at the same distance. Every
+// mismatch is therefore re-examined: all triangles within 1e-12 x diagonal of the
+// nearest distance are collected (CGAL all_intersected_primitives + projection)
+// and a mismatch is a *tie* when every answer (CGAL's and abgs') is the
+// interpolation on one of them; ties are counted (and those across bodies), the
+// rest are *unexplained* and fail the check.
+//
+// Prints progress on stderr and one JSON object on stdout: queries/s single
+// thread (CGAL plain and hinted, abgs plain and hinted) and all threads (CGAL
+// with std::thread, abgs batch, abgs hinted with one hint per thread), build
+// times, and the agreement. Timings are the best of R repetitions.
+// Exit status: 0 agreement (ties allowed), 1 an unexplained mismatch, 2 error.
+#include "harness.hpp"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <atomic>
+
+using namespace harness;
+
+namespace {
+
+using K = CGAL::Epick;
+using Point = K::Point_3;
+using Triangle = K::Triangle_3;
+using TriIt = std::vector<Triangle>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<K, TriIt>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+using Hint = Tree::Point_and_primitive_id;
+
+/// The CGAL side: a tree over the grid's triangles and the vertex sizes.
+struct CgalSizer {
+    const Grid &g;
+    std::vector<Triangle> tris;
+    Tree tree;
+    explicit CgalSizer(const Grid &grid) : g(grid) {
+        tris.reserve(g.triangles());
+        for (size_t f = 0; f < g.triangles(); f++) {
+            auto p = [&](int k) {
+                Vec3 v = g.vertex(g.tri[3 * f + k]);
+                return Point(v[0], v[1], v[2]);
+            };
+            tris.emplace_back(p(0), p(1), p(2));
+        }
+        tree.insert(tris.cbegin(), tris.cend());
+        tree.build();
+        tree.accelerate_distance_queries();
+        // Bodies: triangles connected through shared vertices (union-find).
+        std::vector<uint32_t> parent(g.vertices());
+        for (size_t i = 0; i < parent.size(); i++) parent[i] = static_cast<uint32_t>(i);
+        auto find = [&](uint32_t x) {
+            while (parent[x] != x) x = parent[x] = parent[parent[x]];
+            return x;
+        };
+        for (size_t f = 0; f < g.triangles(); f++)
+            for (int k = 1; k < 3; k++) parent[find(g.tri[3 * f + k])] = find(g.tri[3 * f]);
+        body.resize(g.triangles());
+        for (size_t f = 0; f < g.triangles(); f++) body[f] = find(g.tri[3 * f]);
+    }
+    std::vector<uint32_t> body;  // a representative vertex per triangle's body
+
+    /// The interpolated sizes on every triangle within `eps` of the nearest
+    /// distance to `p` (the candidates of an equidistant tie), with the triangles.
+    std::vector<std::pair<double, size_t>> tie_candidates(const Point &p, double eps) const {
+        Hint h = tree.closest_point_and_primitive(p);
+        const double d = std::sqrt(CGAL::squared_distance(h.first, p)) + eps;
+        CGAL::Bbox_3 box(p.x() - d, p.y() - d, p.z() - d, p.x() + d, p.y() + d, p.z() + d);
+        std::vector<TriIt> prims;
+        tree.all_intersected_primitives(box, std::back_inserter(prims));
+        K::Construct_projected_point_3 project;
+        std::vector<std::pair<double, size_t>> out;
+        for (TriIt it : prims) {
+            Point q = project(*it, p);
+            size_t f = static_cast<size_t>(it - tris.cbegin());
+            if (std::sqrt(CGAL::squared_distance(q, p)) <= d) out.emplace_back(interpolate(f, q), f);
+        }
+        return out;
+    }
+    /// Barycentric interpolation of the vertex sizes of triangle `f` at `q`
+    /// (a point on it), coordinates clamped to the triangle.
+    double interpolate(size_t f, const Point &q) const {
+        const uint32_t *t = &g.tri[3 * f];
+        Vec3 a = g.vertex(t[0]), b = g.vertex(t[1]), c = g.vertex(t[2]);
+        Vec3 v0 = sub(b, a), v1 = sub(c, a), v2 = sub(Vec3{q.x(), q.y(), q.z()}, a);
+        double d00 = dot(v0, v0), d01 = dot(v0, v1), d11 = dot(v1, v1);
+        double d20 = dot(v2, v0), d21 = dot(v2, v1), den = d00 * d11 - d01 * d01;
+        double v = 0.0, w = 0.0;
+        if (den > 0.0) {
+            v = (d11 * d20 - d01 * d21) / den;
+            w = (d00 * d21 - d01 * d20) / den;
+        }
+        v = std::clamp(v, 0.0, 1.0);
+        w = std::clamp(w, 0.0, 1.0);
+        if (v + w > 1.0) {
+            double s = v + w;
+            v /= s;
+            w /= s;
+        }
+        double u = 1.0 - v - w;
+        return u * g.size[t[0]] + v * g.size[t[1]] + w * g.size[t[2]];
+    }
+    double query(const Point &p) const {
+        Hint h = tree.closest_point_and_primitive(p);
+        return interpolate(static_cast<size_t>(h.second - tris.cbegin()), h.first);
+    }
+    double query_hinted(const Point &p, Hint &hint) const {
+        hint = tree.closest_point_and_primitive(p, hint);
+        return interpolate(static_cast<size_t>(hint.second - tris.cbegin()), hint.first);
+    }
+};
+
+std::vector<double> make_points(const std::string &kind, const Grid &g, const CgalSizer &cg, size_t n,
+                                uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    SurfaceSampler sampler(g);
+    const double diag = g.stats.diagonal;
+    std::vector<double> pts;
+    pts.reserve(3 * n);
+    auto push = [&](const Vec3 &p) { pts.insert(pts.end(), p.begin(), p.end()); };
+    auto unit = [&] {
+        for (;;) {
+            Vec3 d{u(rng), u(rng), u(rng)};
+            double l = norm(d);
+            if (l > 1e-3 && l <= 1.0) return mul(d, 1.0 / l);
+        }
+    };
+    if (kind == "near") {
+        for (size_t i = 0; i < n; i++) {
+            Vec3 nrm;
+            Vec3 p = sampler.sample(rng, nullptr, &nrm);
+            push(add(p, mul(nrm, 0.01 * diag * u(rng))));
+        }
+    } else if (kind == "uniform") {
+        const double *lo = g.stats.bbox_min, *hi = g.stats.bbox_max;
+        for (size_t i = 0; i < n; i++) {
+            Vec3 p;
+            for (int k = 0; k < 3; k++) p[k] = lo[k] + (hi[k] - lo[k]) * 0.5 * (u(rng) + 1.0);
+            push(p);
+        }
+    } else {  // walk
+        Vec3 p{}, d{};
+        for (size_t i = 0; i < n; i++) {
+            if (i % 2000 == 0) {
+                p = sampler.sample(rng);
+                d = unit();
+            }
+            double step = 0.5 * cg.query(Point(p[0], p[1], p[2]));
+            Vec3 turn = add(d, mul(unit(), 0.5));
+            d = mul(turn, 1.0 / norm(turn));
+            Vec3 q = add(p, mul(d, step));
+            Point c = cg.tree.closest_point(Point(q[0], q[1], q[2]));
+            Vec3 np{c.x(), c.y(), c.z()};
+            if (norm(sub(np, p)) > 0.0) d = mul(sub(np, p), 1.0 / norm(sub(np, p)));
+            p = np;
+            push(add(p, mul(unit(), 0.1 * step * 0.5 * (u(rng) + 1.0))));
+        }
+    }
+    return pts;
+}
+
+/// Best wall time of `reps` runs of `f`.
+template <class F> double best_of(int reps, F f) {
+    double best = 1e300;
+    for (int r = 0; r < reps; r++) {
+        double t = now();
+        f();
+        best = std::min(best, now() - t);
+    }
+    return best;
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+    Args args(argc, argv);
+    if (args.pos.size() != 1) {
+        std::fprintf(stderr, "usage: compare_queries GRID [--points N] [--reps R] [--seed S] [--tolerance T]\n");
+        return 2;
+    }
+    const size_t n = static_cast<size_t>(args.num("points", 200000));
+    const int reps = static_cast<int>(args.num("reps", 3));
+    const uint64_t seed = static_cast<uint64_t>(args.num("seed", 1));
+    const double tol = args.num("tolerance", 1e-9);
+    const unsigned threads = all_threads();
+
+    Grid g;
+    g.load(args.pos[0]);
+    if (!g.stats.has_sizes) {
+        std::fprintf(stderr, "%s has no sizes\n", args.pos[0].c_str());
+        return 2;
+    }
+    double t0 = now();
+    CgalSizer cg(g);
+    const double cgal_build = now() - t0;
+    // abgs' build time: the same arrays through abgs_grid_from_arrays (validation + BVH).
+    Grid again;
+    t0 = now();
+    again.from_arrays(g.xyz, g.tri, g.size);
+    const double abgs_build = now() - t0;
+
+    Json out;
+    out.str("grid", args.pos[0])
+        .num("faces", static_cast<double>(g.triangles()))
+        .num("vertices", static_cast<double>(g.vertices()))
+        .num("points", static_cast<double>(n))
+        .num("threads", threads)
+        .num("cgal_build_s", cgal_build)
+        .num("abgs_build_s", abgs_build);
+    std::fprintf(stderr, "%s: %zu faces, %zu points per set, %u threads; build CGAL %.3f s, abgs %.3f s\n",
+                 args.pos[0].c_str(), g.triangles(), n, threads, cgal_build, abgs_build);
+
+    bool all_agree = true;
+    for (const char *kind : {"near", "uniform", "walk"}) {
+        std::vector<double> pts = make_points(kind, g, cg, n, seed);
+        std::vector<Point> cpts(n);
+        for (size_t i = 0; i < n; i++) cpts[i] = Point(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
+        std::vector<double> ref(n), ref_h(n), plain(n), hinted(n), batch(n), hinted_mt(n), cgal_mt(n);
+
+        double t_cgal = best_of(reps, [&] {
+            for (size_t i = 0; i < n; i++) ref[i] = cg.query(cpts[i]);
+        });
+        double t_cgal_h = best_of(reps, [&] {
+            Hint h = cg.tree.closest_point_and_primitive(cpts[0]);
+            for (size_t i = 0; i < n; i++) ref_h[i] = cg.query_hinted(cpts[i], h);
+        });
+        double t_plain = best_of(reps, [&] {
+            for (size_t i = 0; i < n; i++) check(abgs_query_size(g.g, &pts[3 * i], &plain[i]), "abgs_query_size");
+        });
+        double t_hinted = best_of(reps, [&] {
+            uint32_t hint = ABGS_NO_HINT;
+            for (size_t i = 0; i < n; i++)
+                check(abgs_query_size_hinted(g.g, &pts[3 * i], &hint, &hinted[i]), "abgs_query_size_hinted");
+        });
+        double t_cgal_mt = best_of(reps, [&] {
+            parallel_chunks(n, threads, [&](size_t b, size_t e, unsigned) {
+                for (size_t i = b; i < e; i++) cgal_mt[i] = cg.query(cpts[i]);
+            });
+        });
+        double t_batch = best_of(reps, [&] { check(abgs_query_sizes(g.g, pts.data(), n, batch.data()), "abgs_query_sizes"); });
+        double t_hinted_mt = best_of(reps, [&] {
+            parallel_chunks(n, threads, [&](size_t b, size_t e, unsigned) {
+                uint32_t hint = ABGS_NO_HINT;
+                for (size_t i = b; i < e; i++) abgs_query_size_hinted(g.g, &pts[3 * i], &hint, &hinted_mt[i]);
+            });
+        });
+
+        // Agreement: every answer (abgs' and CGAL's hinted / threaded) against
+        // CGAL's plain one; mismatches re-examined for equidistant ties.
+        double max_rel = 0.0, max_rel_untied = 0.0;
+        size_t bad = 0, ties = 0, ties_bodies = 0, unexplained = 0;
+        auto rel = [&](double a, double b) { return std::fabs(a - b) / std::fabs(b); };
+        const double eps = 1e-12 * g.stats.diagonal;
+        for (size_t i = 0; i < n; i++) {
+            const double answers[] = {ref[i], plain[i], hinted[i], batch[i], hinted_mt[i], ref_h[i], cgal_mt[i]};
+            double r = 0.0;
+            for (double a : answers) r = std::max(r, std::isnan(a) ? INFINITY : rel(a, ref[i]));
+            max_rel = std::max(max_rel, r);
+            if (r <= tol) {
+                max_rel_untied = std::max(max_rel_untied, r);
+                continue;
+            }
+            bad++;
+            auto cand = cg.tie_candidates(cpts[i], eps);
+            bool explained = true, bodies = false;
+            for (double a : answers) {
+                bool found = false;
+                for (const auto &c : cand) found = found || rel(a, c.first) <= tol;
+                explained = explained && found;
+            }
+            for (const auto &c : cand) bodies = bodies || cg.body[c.second] != cg.body[cand[0].second];
+            if (explained) {
+                ties++;
+                ties_bodies += bodies;
+                if (ties <= 2) {
+                    std::fprintf(stderr, "  %s point %zu: tie, %zu triangles at the nearest distance:", kind, i,
+                                 cand.size());
+                    for (const auto &c : cand)
+                        std::fprintf(stderr, " %zu (body %u) %.9g;", c.second, cg.body[c.second], c.first);
+                    std::fprintf(stderr, " CGAL %.17g, abgs %.17g\n", ref[i], plain[i]);
+                }
+                continue;
+            }
+            unexplained++;
+            max_rel_untied = std::max(max_rel_untied, r);
+            if (unexplained <= 5) {
+                abgs_hit hit;
+                check(abgs_query_closest(g.g, &pts[3 * i], ABGS_NO_HINT, &hit), "abgs_query_closest");
+                Hint h = cg.tree.closest_point_and_primitive(cpts[i]);
+                std::fprintf(stderr,
+                             "  %s point %zu (%.17g %.17g %.17g): CGAL %.17g (triangle %zu, distance %.17g), "
+                             "abgs %.17g / hinted %.17g / batch %.17g (triangle %u, distance %.17g)\n",
+                             kind, i, pts[3 * i], pts[3 * i + 1], pts[3 * i + 2], ref[i],
+                             static_cast<size_t>(h.second - cg.tris.cbegin()),
+                             std::sqrt(CGAL::squared_distance(h.first, cpts[i])), plain[i], hinted[i], batch[i],
+                             hit.triangle, hit.distance);
+            }
+        }
+        all_agree = all_agree && unexplained == 0;
+        std::string k = kind;
+        double q = static_cast<double>(n);
+        out.num(k + "_cgal_qps", q / t_cgal)
+            .num(k + "_cgal_hinted_qps", q / t_cgal_h)
+            .num(k + "_abgs_qps", q / t_plain)
+            .num(k + "_abgs_hinted_qps", q / t_hinted)
+            .num(k + "_cgal_mt_qps", q / t_cgal_mt)
+            .num(k + "_abgs_batch_qps", q / t_batch)
+            .num(k + "_abgs_hinted_mt_qps", q / t_hinted_mt)
+            .num(k + "_max_rel_diff", max_rel)
+            .num(k + "_max_rel_diff_untied", max_rel_untied)
+            .num(k + "_mismatches", static_cast<double>(bad))
+            .num(k + "_ties", static_cast<double>(ties))
+            .num(k + "_ties_across_bodies", static_cast<double>(ties_bodies))
+            .num(k + "_unexplained", static_cast<double>(unexplained));
+        std::fprintf(stderr,
+                     "%-8s 1 thread: CGAL %.3g q/s (hinted %.3g), abgs %.3g q/s (x%.1f), hinted %.3g (x%.1f); "
+                     "%u threads: CGAL %.3g, abgs batch %.3g (x%.1f), hinted %.3g; max rel diff %.2g, %zu over %.0e "
+                     "(%zu equidistant ties, %zu of them across bodies; %zu unexplained)\n",
+                     kind, q / t_cgal, q / t_cgal_h, q / t_plain, t_cgal / t_plain, q / t_hinted, t_cgal / t_hinted,
+                     threads, q / t_cgal_mt, q / t_batch, t_cgal_mt / t_batch, q / t_hinted_mt, max_rel, bad, tol,
+                     ties, ties_bodies, unexplained);
+    }
+    out.num("tolerance", tol).boolean("agree", all_agree).print();
+    if (!all_agree) std::fprintf(stderr, "compare_queries: abgs and CGAL disagree beyond %.0e\n", tol);
+    return all_agree ? 0 : 1;
+}
