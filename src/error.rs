@@ -65,5 +65,17 @@ impl Error {
     }
 }
 
+/// Checks a parameter: `x` finite and within `[lo, hi]`, else
+/// [`Error::InvalidArgument`] naming it (`what = x must be in [lo, hi]`).
+pub(crate) fn check_range(x: f64, lo: f64, hi: f64, what: &str) -> Result<()> {
+    if x.is_finite() && x >= lo && x <= hi {
+        Ok(())
+    } else {
+        Err(Error::InvalidArgument(format!(
+            "{what} = {x} must be in [{lo}, {hi}]"
+        )))
+    }
+}
+
 /// Shorthand for `std::result::Result<T, abgs::Error>`.
 pub type Result<T> = std::result::Result<T, Error>;

@@ -55,6 +55,8 @@ pub mod sampling;
 pub mod simplify;
 pub mod sizing;
 pub mod spatial;
+#[cfg(test)]
+mod test_shapes;
 
 pub use error::{Error, Result};
 pub use mesh::{BuildOptions, Grid, ValidationReport};

@@ -2,11 +2,10 @@
 //! simplification → evaluation, with a report and two pictures.
 
 use crate::render::{line_chart_png, preview_png, Panel, Series};
-use crate::simplify::{iterations_json, params_json, report_json, run_lbo, write_json};
+use crate::simplify::{iterations_json, params_json, report_json, run_lbo, write_json, LboArgs};
 use abgs::metrics::{evaluate, EvalParams};
 use abgs::qem::{decimate, QemParams};
 use abgs::remesh::{remesh, RemeshParams, TargetLength};
-use abgs::simplify::SimplifyParams;
 use abgs::sizing::{self, SizeParams};
 use abgs::{Error, Grid, Result};
 use serde_json::{json, Value};
@@ -34,21 +33,9 @@ pub struct RunArgs {
     /// Gradation ratio β.
     #[arg(long, default_value_t = 1.2)]
     pub beta: f64,
-    /// Largest share of the edges collapsed per iteration (n).
-    #[arg(long, default_value_t = SimplifyParams::default().fraction)]
-    pub fraction: f64,
-    /// Largest size ratio a collapse may cause (T_size).
-    #[arg(long, default_value_t = SimplifyParams::default().t_size)]
-    pub t_size: f64,
-    /// Largest distance to the dense grid as a fraction of the local size (τ_d).
-    #[arg(long, default_value_t = SimplifyParams::default().tau_d)]
-    pub tau_d: f64,
-    /// Largest distance to the dense grid in model units (default: no limit).
-    #[arg(long)]
-    pub max_distance: Option<f64>,
-    /// Most simplification iterations.
-    #[arg(long = "max-iter", default_value_t = SimplifyParams::default().max_iterations)]
-    pub max_iterations: usize,
+    /// Simplification thresholds.
+    #[command(flatten)]
+    pub lbo: LboArgs,
     /// Also decimate the dense grid by plain QEM to the same face count (sizes
     /// re-projected) and evaluate it: what sizing-awareness buys.
     #[arg(long)]
@@ -101,15 +88,7 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
     };
     let fields = stage("sizes", &mut times, || sizing::compute(&dense, &sp))?;
     dense.set_sizes(fields.h.clone())?;
-    let params = SimplifyParams {
-        fraction: a.fraction,
-        t_size: a.t_size,
-        tau_d: a.tau_d,
-        max_distance: a.max_distance,
-        max_iterations: a.max_iterations,
-        feature_angle_deg: a.feature_angle,
-        ..Default::default()
-    };
+    let params = a.lbo.params(a.feature_angle, true);
     let t = Instant::now();
     let simplified = run_lbo(&dense, &params)?;
     times.push(("simplify".into(), t.elapsed().as_secs_f64()));

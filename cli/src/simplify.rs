@@ -20,9 +20,10 @@ pub enum Method {
     Qem,
 }
 
-/// Options of LBO-ABGS (mirrors [`SimplifyParams`]).
+/// The LBO-ABGS thresholds shared by `abgs simplify` and `abgs run` (fields of
+/// [`SimplifyParams`]).
 #[derive(clap::Args, Debug, Clone)]
-pub struct SimplifyArgs {
+pub struct LboArgs {
     /// Largest share of the edges collapsed per iteration (n).
     #[arg(long, default_value_t = SimplifyParams::default().fraction)]
     pub fraction: f64,
@@ -38,6 +39,30 @@ pub struct SimplifyArgs {
     /// Most iterations.
     #[arg(long = "max-iter", default_value_t = SimplifyParams::default().max_iterations)]
     pub max_iterations: usize,
+}
+
+impl LboArgs {
+    /// The library parameters, with the feature angle and repair switch given.
+    pub fn params(&self, feature_angle_deg: f64, repair: bool) -> SimplifyParams {
+        SimplifyParams {
+            fraction: self.fraction,
+            t_size: self.t_size,
+            tau_d: self.tau_d,
+            max_distance: self.max_distance,
+            max_iterations: self.max_iterations,
+            feature_angle_deg,
+            repair,
+            ..Default::default()
+        }
+    }
+}
+
+/// Options of `abgs simplify` for LBO-ABGS.
+#[derive(clap::Args, Debug, Clone)]
+pub struct SimplifyArgs {
+    /// Thresholds.
+    #[command(flatten)]
+    pub lbo: LboArgs,
     /// Feature angle in degrees.
     #[arg(long, default_value_t = SimplifyParams::default().feature_angle_deg)]
     pub feature_angle: f64,
@@ -49,16 +74,7 @@ pub struct SimplifyArgs {
 impl SimplifyArgs {
     /// The library parameters.
     pub fn params(&self) -> SimplifyParams {
-        SimplifyParams {
-            fraction: self.fraction,
-            t_size: self.t_size,
-            tau_d: self.tau_d,
-            max_distance: self.max_distance,
-            max_iterations: self.max_iterations,
-            feature_angle_deg: self.feature_angle,
-            repair: !self.no_repair,
-            ..Default::default()
-        }
+        self.lbo.params(self.feature_angle, !self.no_repair)
     }
 }
 

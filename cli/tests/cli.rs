@@ -13,6 +13,46 @@ fn tmp(name: &str) -> PathBuf {
     d.join(name)
 }
 
+/// Fails with the command's stderr unless it exited with success.
+fn assert_ok(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The unit square subdivided n × n (two triangles per cell) at height `z(x)`.
+fn plate_arrays(n: usize, z: impl Fn(f64) -> f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut v = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            v.push([x, y, z(x)]);
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    (v, t)
+}
+
+/// A bumpy plate `z = 0.05·sin(k·x)` without sizes, written to `name`.
+fn bumpy_plate(name: &str, n: usize, k: f64) -> PathBuf {
+    let (v, t) = plate_arrays(n, |x| 0.05 * (k * x).sin());
+    let path = tmp(name);
+    abgs::Grid::from_arrays(v, t, None, &abgs::BuildOptions::default())
+        .unwrap()
+        .save(&path)
+        .unwrap();
+    path
+}
+
 /// A small grid with sizes, written as VTK.
 fn sized_grid(tag: &str) -> PathBuf {
     let path = tmp(&format!("plate-{tag}.vtk"));
@@ -68,11 +108,7 @@ fn query_answers_in_order_in_both_modes() {
         .arg(&pts)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let vals: Vec<f64> = String::from_utf8_lossy(&out.stdout)
         .lines()
         .map(|l| l.parse().unwrap())
@@ -148,11 +184,7 @@ fn bench_query_runs_and_answers_agree() {
         .args(["--points", "2000", "--seconds", "0.01", "--json"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     for set in v["results"].as_array().unwrap() {
         for run in set["runs"].as_array().unwrap() {
@@ -165,27 +197,7 @@ fn bench_query_runs_and_answers_agree() {
 #[test]
 fn size_writes_all_arrays_and_check_gradation_passes() {
     // A bumpy plate so that curvature matters.
-    let n = 30;
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-            v.push([x, y, 0.05 * (8.0 * x).sin()]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let input = tmp("bumpy.obj");
-    abgs::Grid::from_arrays(v, t, None, &abgs::BuildOptions::default())
-        .unwrap()
-        .save(&input)
-        .unwrap();
+    let input = bumpy_plate("bumpy.obj", 30, 8.0);
     let out = tmp("bumpy-sized.vtk");
     let st = abgs()
         .arg("size")
@@ -195,11 +207,7 @@ fn size_writes_all_arrays_and_check_gradation_passes() {
         .args(["--beta", "1.3", "--source", "point 0.5 0.5 0 0.003 0.05"])
         .output()
         .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+    assert_ok(&st);
     let g = abgs::Grid::load(&out).unwrap();
     let names: Vec<&str> = g.point_arrays().iter().map(|a| a.name.as_str()).collect();
     for want in ["h0", "h_curv", "h_prox", "lbo"] {
@@ -328,11 +336,7 @@ fn grid_remeshes_uniformly_and_by_sizes_and_checks() {
         .args(["--source", "point 0 0 0 0.03 0.3"])
         .output()
         .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+    assert_ok(&st);
     let dense2 = tmp("box-dense2.vtk");
     let out = abgs()
         .arg("grid")
@@ -454,27 +458,7 @@ fn grid_check_failures_and_bad_arguments_exit_1() {
 #[test]
 fn eval_reports_json_and_a_table() {
     // A sized bumpy plate (via `abgs size`) against itself and against a 2-face plate.
-    let n = 20;
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-            v.push([x, y, 0.05 * (6.0 * x).sin()]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let input = tmp("eval-plate.obj");
-    abgs::Grid::from_arrays(v, t, None, &abgs::BuildOptions::default())
-        .unwrap()
-        .save(&input)
-        .unwrap();
+    let input = bumpy_plate("eval-plate.obj", 20, 6.0);
     let dense = tmp("eval-plate-sized.vtk");
     let st = abgs()
         .arg("size")
@@ -483,11 +467,7 @@ fn eval_reports_json_and_a_table() {
         .arg(&dense)
         .output()
         .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+    assert_ok(&st);
     let eval = |candidate: &PathBuf, json: bool| {
         let mut c = abgs();
         c.arg("eval")
@@ -502,11 +482,7 @@ fn eval_reports_json_and_a_table() {
         c.output().unwrap()
     };
     let out = eval(&dense, true);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["faces_reference"], 800);
     assert_eq!(v["faces_candidate"], 800);
@@ -524,11 +500,7 @@ fn eval_reports_json_and_a_table() {
     // A 2-face flat candidate: reduction, deviation and distance are reported.
     let coarse = sized_grid("eval");
     let out = eval(&coarse, true);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["reduction"], 1.0 - 2.0 / 800.0);
     assert!(v["size_deviation"]["max"].as_f64().unwrap() > 1.0);
@@ -548,21 +520,7 @@ fn eval_reports_json_and_a_table() {
 /// A plate subdivided n × n with sizes 0.02 + 0.2·x, written as VTK.
 fn dense_plate(tag: &str, n: usize) -> PathBuf {
     let path = tmp(&format!("dense-plate-{tag}.vtk"));
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            v.push([i as f64 / n as f64, j as f64 / n as f64, 0.0]);
-        }
-    }
-    let mut t = Vec::new();
-    for j in 0..n as u32 {
-        for i in 0..n as u32 {
-            let a = j * (n as u32 + 1) + i;
-            let (b, c, d) = (a + 1, a + n as u32 + 2, a + n as u32 + 1);
-            t.push([a, b, c]);
-            t.push([a, c, d]);
-        }
-    }
+    let (v, t) = plate_arrays(n, |_| 0.0);
     let s = v.iter().map(|p| 0.02 + 0.2 * p[0]).collect();
     abgs::Grid::from_arrays(v, t, Some(s), &abgs::BuildOptions::default())
         .unwrap()

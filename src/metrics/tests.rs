@@ -4,21 +4,7 @@ use crate::mesh::BuildOptions;
 /// The unit square `n × n` (two triangles per cell), lifted to `z(x, y)`, with
 /// sizes `h(x, y, z)` (none when `h` is `None`).
 fn plate(n: usize, z: impl Fn(f64, f64) -> f64, h: Option<&dyn Fn([f64; 3]) -> f64>) -> Grid {
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-            v.push([x, y, z(x, y)]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
+    let (v, t) = crate::test_shapes::unit_square(n, z);
     let s = h.map(|h| v.iter().map(|&p| h(p)).collect());
     Grid::from_arrays(v, t, s, &BuildOptions::default()).unwrap()
 }

@@ -260,7 +260,7 @@ pub fn decimate(input: &Grid, params: &QemParams) -> Result<Decimated> {
     let start = Instant::now();
     let features = Features::detect(input, params.feature_angle_deg);
     let (mut mesh, _) = HalfedgeMesh::from_grid(input, Some(&features));
-    mark_turning_corners(&mut mesh, params.feature_angle_deg);
+    crate::remesh::reference::mark_corners(&mut mesh, params.feature_angle_deg);
     let quadric = initial_quadrics(&mesh, params.boundary_weight);
     let ne = mesh.n_edges();
     let mut d = Decimator {
@@ -293,37 +293,6 @@ pub fn decimate(input: &Grid, params: &QemParams) -> Result<Decimated> {
         collapses,
         seconds: start.elapsed().as_secs_f64(),
     })
-}
-
-/// Marks as corners the feature vertices where the line turns by more than
-/// `angle_deg` (the feature vertices whose feature valence is not 2 are
-/// corners already).
-fn mark_turning_corners(mesh: &mut HalfedgeMesh, angle_deg: f64) {
-    let cos_c = angle_deg.to_radians().cos();
-    for v in 0..mesh.n_vertices() as u32 {
-        let fl = mesh.vertex_flags[v as usize];
-        if fl & V_FEATURE == 0 || fl & V_CORNER != 0 || mesh.is_isolated(v) {
-            continue;
-        }
-        let ends: Vec<u32> = mesh
-            .outgoing(v)
-            .filter(|&h| mesh.edge_flags[mesh.edge(h) as usize] & E_FEATURE != 0)
-            .map(|h| mesh.to_vertex(h))
-            .collect();
-        let turned = match ends[..] {
-            [a, b] => {
-                let p = mesh.positions[v as usize];
-                let d1 = sub(p, mesh.positions[a as usize]);
-                let d2 = sub(mesh.positions[b as usize], p);
-                let (l1, l2) = (norm(d1), norm(d2));
-                !(l1 > 0.0 && l2 > 0.0) || dot(d1, d2) < cos_c * l1 * l2
-            }
-            _ => true,
-        };
-        if turned {
-            mesh.vertex_flags[v as usize] |= V_CORNER;
-        }
-    }
 }
 
 /// Area-weighted face planes plus weighted constraint planes along feature

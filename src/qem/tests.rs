@@ -13,20 +13,7 @@ fn build(v: Vec<[f64; 3]>, t: Vec<[u32; 3]>, h: Option<Vec<f64>>) -> Grid {
 
 /// The unit square in z = 0, n × n quads split into triangles.
 fn square(n: usize) -> Grid {
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut v = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            v.push([i as f64 / n as f64, j as f64 / n as f64, 0.0]);
-        }
-    }
-    let mut t = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
+    let (v, t) = crate::test_shapes::unit_square(n, |_, _| 0.0);
     build(v, t, None)
 }
 

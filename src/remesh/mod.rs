@@ -203,15 +203,7 @@ pub fn remesh_sized(input: &Grid, sizing: &Grid, params: &RemeshParams) -> Resul
 }
 
 fn check(params: &RemeshParams) -> Result<()> {
-    let within = |x: f64, lo: f64, hi: f64, what: &str| -> Result<()> {
-        if x.is_finite() && x >= lo && x <= hi {
-            Ok(())
-        } else {
-            Err(Error::InvalidArgument(format!(
-                "{what} = {x} must be in [{lo}, {hi}]"
-            )))
-        }
-    };
+    let within = crate::error::check_range;
     within(params.feature_angle_deg, 0.0, 180.0, "feature_angle_deg")?;
     within(params.corner_angle_deg, 0.0, 180.0, "corner_angle_deg")?;
     within(params.n_circle, 1e-9, 1e9, "n_circle")?;

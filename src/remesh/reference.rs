@@ -31,11 +31,10 @@ impl FeatureLines {
     }
 }
 
-/// Marks corners where a feature line turns by more than `corner_deg`, then
-/// numbers the feature lines (chains of feature edges between corners, or
-/// closed loops) in `mesh.edge_line`, and collects them as segments.
-/// Returns the lines and the number of turning corners added.
-pub fn feature_lines(mesh: &mut HalfedgeMesh, corner_deg: f64) -> (FeatureLines, usize) {
+/// Marks as corners the feature vertices whose feature valence is not 2 and
+/// those where the line turns by more than `corner_deg`; returns how many
+/// turning corners it added. O(V · valence).
+pub(crate) fn mark_corners(mesh: &mut HalfedgeMesh, corner_deg: f64) -> usize {
     let cos_c = corner_deg.to_radians().cos();
     let mut turned = 0;
     for v in 0..mesh.n_vertices() as u32 {
@@ -61,6 +60,15 @@ pub fn feature_lines(mesh: &mut HalfedgeMesh, corner_deg: f64) -> (FeatureLines,
             turned += 1;
         }
     }
+    turned
+}
+
+/// Marks corners (see [`mark_corners`]), then numbers the feature lines
+/// (chains of feature edges between corners, or closed loops) in
+/// `mesh.edge_line`, and collects them as segments.
+/// Returns the lines and the number of turning corners added.
+pub fn feature_lines(mesh: &mut HalfedgeMesh, corner_deg: f64) -> (FeatureLines, usize) {
+    let turned = mark_corners(mesh, corner_deg);
     let ne = mesh.n_edges();
     for e in 0..ne {
         mesh.edge_line[e] = NONE;

@@ -93,15 +93,7 @@ impl Default for SimplifyParams {
 impl SimplifyParams {
     /// Errors with a message naming the first parameter out of range.
     pub fn check(&self) -> Result<()> {
-        let within = |x: f64, lo: f64, hi: f64, what: &str| -> Result<()> {
-            if x.is_finite() && x >= lo && x <= hi {
-                Ok(())
-            } else {
-                Err(Error::InvalidArgument(format!(
-                    "{what} = {x} must be in [{lo}, {hi}]"
-                )))
-            }
-        };
+        let within = crate::error::check_range;
         within(self.fraction, 1e-9, 1.0, "fraction")?;
         within(self.pool_factor, 1.0, 1e6, "pool_factor")?;
         within(self.t_size, 1.0 + 1e-9, 1e9, "t_size")?;

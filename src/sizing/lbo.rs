@@ -103,20 +103,7 @@ mod tests {
     use crate::mesh::BuildOptions;
 
     fn plate(n: usize, f: impl Fn(f64, f64) -> f64) -> (Grid, Vec<f64>) {
-        let mut v = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                v.push([i as f64 / n as f64, j as f64 / n as f64, 0.0]);
-            }
-        }
-        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let mut t = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-            }
-        }
+        let (v, t) = crate::test_shapes::unit_square(n, |_, _| 0.0);
         let h = v.iter().map(|p| f(p[0], p[1])).collect();
         (
             Grid::from_arrays(v, t, None, &BuildOptions::default()).unwrap(),
