@@ -120,6 +120,31 @@ fn deviation_of_a_constant_candidate() {
 }
 
 #[test]
+fn hausdorff_is_the_exact_maximum_over_its_samples() {
+    // The sweep skips points proven within the running maximum; the result must
+    // still be the largest exact distance over every sample and vertex.
+    let a = plate(40, bumpy, None);
+    let b = plate(9, |x, y| 0.8 * bumpy(x, y), None);
+    for (from, to) in [(&a, &b), (&b, &a)] {
+        let mut pts: Vec<[f64; 3]> = surface_points(from, 5000, 11)
+            .into_iter()
+            .map(|s| s.1)
+            .collect();
+        pts.extend_from_slice(from.vertices());
+        let brute = pts
+            .iter()
+            .map(|&p| to.bvh().closest(p, None).unwrap().closest.dist2)
+            .fold(0.0, f64::max)
+            .sqrt();
+        assert!(brute > 0.0);
+        assert_eq!(
+            hausdorff_directed(from, to, 5000, 11).to_bits(),
+            brute.to_bits()
+        );
+    }
+}
+
+#[test]
 fn same_bits_whatever_the_thread_count() {
     let reference = plate(60, bumpy, Some(&field));
     let candidate = plate(13, |x, y| 0.9 * bumpy(x, y), Some(&|p| 1.3 * field(p)));

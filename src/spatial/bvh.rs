@@ -2,15 +2,14 @@
 //! depth-first node array (left child stored right after its parent), triangle
 //! corners copied into leaf order so a leaf is one contiguous read.
 //!
-//! Build: O(F log F) time, parallel over subtrees. Memory: 56 bytes per node
-//! (about 0.6 nodes per triangle) plus 76 bytes per triangle.
+//! Build: O(F log F) time, parallel over subtrees. Memory: 64 bytes per node
+//! (one cache line; about 0.6 nodes per triangle) plus 76 bytes per triangle.
 //!
 //! Closest-point query: exact (f64 point–triangle distance), ties broken by the
 //! lowest triangle index, so the answer depends only on the point — never on the
 //! traversal order or a hint. Expected O(log F) for points near the surface.
 
 use crate::geometry::{closest_point_triangle, Aabb, ClosestPoint};
-
 /// Largest leaf the SAH may choose.
 const MAX_LEAF: usize = 4;
 /// SAH bins per split.
@@ -22,8 +21,9 @@ const SAH_DEPTH: usize = 60;
 /// Upper bound on the tree depth, so traversal stacks can be fixed arrays.
 pub const MAX_DEPTH: usize = 128;
 
-/// One node of the flattened tree.
+/// One node of the flattened tree (one cache line).
 #[derive(Debug, Clone, Copy)]
+#[repr(align(64))]
 pub struct Node {
     /// Bounds of every triangle below.
     pub bbox: Aabb,
@@ -53,6 +53,56 @@ pub struct Bvh {
     pub prim_corners: Vec<[[f64; 3]; 3]>,
     /// Primitive slot of each triangle (inverse of `prim_triangle`).
     pub triangle_prim: Vec<u32>,
+    /// Largest absolute coordinate of the root box (scale of rounding errors).
+    pub coord_scale: f64,
+}
+
+/// Best candidate of a closest-point search.
+struct Best {
+    tri: u32,
+    cp: ClosestPoint,
+    /// Squared distance of the best candidate (or the initial bound).
+    d2: f64,
+    /// Boxes farther than this (squared) are pruned: `d2` plus rounding slack.
+    limit: f64,
+    slack: f64,
+}
+
+impl Best {
+    fn new(p: [f64; 3], bound2: f64, slack: f64) -> Best {
+        Best {
+            tri: u32::MAX,
+            cp: ClosestPoint {
+                point: p,
+                bary: [1.0, 0.0, 0.0],
+                dist2: f64::INFINITY,
+            },
+            d2: bound2,
+            limit: padded(bound2, slack),
+            slack,
+        }
+    }
+
+    /// Keeps `cp` (on triangle `tri`) if it is closer, or equally close with a
+    /// lower triangle index.
+    #[inline(always)]
+    fn offer(&mut self, tri: u32, cp: ClosestPoint) {
+        if cp.dist2 < self.d2 || (cp.dist2 == self.d2 && tri < self.tri) {
+            if cp.dist2 != self.d2 {
+                self.limit = padded(cp.dist2, self.slack);
+            }
+            self.d2 = cp.dist2;
+            self.tri = tri;
+            self.cp = cp;
+        }
+    }
+}
+
+/// `(sqrt(d2) + slack)^2`, rounded up a little; infinity stays infinity.
+#[inline]
+fn padded(d2: f64, slack: f64) -> f64 {
+    let r = d2.sqrt() + slack;
+    r * r * (1.0 + 1e-12)
 }
 
 /// Result of a closest-point query.
@@ -91,6 +141,12 @@ impl Bvh {
             return Bvh::default();
         }
         let nodes = build_rec(&mut prims, 0, 0);
+        let b = nodes[0].bbox;
+        let coord_scale = b
+            .min
+            .iter()
+            .chain(&b.max)
+            .fold(0.0f64, |m, c| m.max(c.abs()));
         let prim_triangle: Vec<u32> = prims.iter().map(|p| p.tri).collect();
         let prim_corners = prim_triangle
             .iter()
@@ -105,6 +161,7 @@ impl Bvh {
             prim_triangle,
             prim_corners,
             triangle_prim,
+            coord_scale,
         }
     }
 
@@ -168,7 +225,8 @@ impl Bvh {
         self.search(p, None, max_distance * max_distance, keep)
     }
 
-    /// Branch and bound from the bound `bound2` (squared distance), seeded by `hint`.
+    /// Branch and bound from the bound `bound2` (squared distance), seeded by
+    /// `hint`: top-down from the root, nearer child first.
     fn search(
         &self,
         p: [f64; 3],
@@ -179,62 +237,120 @@ impl Bvh {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best_d2 = bound2;
-        let mut best_tri = u32::MAX;
-        let mut best_cp = ClosestPoint {
-            point: p,
-            bary: [1.0, 0.0, 0.0],
-            dist2: f64::INFINITY,
+        let mut best = Best::new(p, bound2, self.slack(&p));
+        // In range first: `keep` may index by triangle.
+        if let Some(h) = hint.filter(|&h| (h as usize) < self.triangle_prim.len() && keep(h)) {
+            let c = &self.prim_corners[self.triangle_prim[h as usize] as usize];
+            best.offer(h, closest_point_triangle(p, c[0], c[1], c[2]));
+        }
+        if self.nodes[0].bbox.distance2(&p) <= best.limit {
+            self.descend(&p, &mut best, &keep);
+        }
+        (best.tri != u32::MAX).then_some(ClosestHit {
+            triangle: best.tri,
+            closest: best.cp,
+        })
+    }
+
+    /// Some triangle whose (computed) squared distance to `p` is at most `r2`,
+    /// or `None` when there is none. The search stops at the first one found,
+    /// the `hint` triangle tried first: a cheap test of "is `p` within `r` of
+    /// the surface". O(log F) expected when the answer is yes near the hint;
+    /// O(log F + k) otherwise, k = triangles whose boxes come within `r`.
+    pub fn any_within(&self, p: [f64; 3], r2: f64, hint: Option<u32>) -> Option<u32> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let test = |slot: usize| {
+            let c = &self.prim_corners[slot];
+            closest_point_triangle(p, c[0], c[1], c[2]).dist2 <= r2
         };
-        if let Some(h) = hint {
-            // In range first: `keep` may index by triangle.
-            if let Some(&slot) = self.triangle_prim.get(h as usize).filter(|_| keep(h)) {
-                let c = &self.prim_corners[slot as usize];
-                let cp = closest_point_triangle(p, c[0], c[1], c[2]);
-                if cp.dist2 < best_d2 {
-                    best_d2 = cp.dist2;
-                    best_cp = cp;
-                    best_tri = h;
-                }
+        if let Some(&slot) = hint.and_then(|h| self.triangle_prim.get(h as usize)) {
+            if test(slot as usize) {
+                return hint;
             }
         }
+        let limit = padded(r2, self.slack(&p));
+        if self.nodes[0].bbox.distance2(&p) > limit {
+            return None;
+        }
+        let mut stack = [0u32; MAX_DEPTH + 1];
+        let mut sp = 1usize;
+        while sp > 0 {
+            sp -= 1;
+            let ni = stack[sp] as usize;
+            let n = &self.nodes[ni];
+            if n.is_leaf() {
+                let s = n.start as usize;
+                if let Some(slot) = (s..s + n.count as usize).find(|&slot| test(slot)) {
+                    return Some(self.prim_triangle[slot]);
+                }
+                continue;
+            }
+            // Children within reach, the nearer popped first.
+            let (l, r) = (ni + 1, n.start as usize);
+            let dl = self.nodes[l].bbox.distance2(&p);
+            let dr = self.nodes[r].bbox.distance2(&p);
+            let (near, dn, far, df) = if dl <= dr {
+                (l, dl, r, dr)
+            } else {
+                (r, dr, l, dl)
+            };
+            if df <= limit {
+                stack[sp] = far as u32;
+                sp += 1;
+            }
+            if dn <= limit {
+                stack[sp] = near as u32;
+                sp += 1;
+            }
+        }
+        None
+    }
+
+    /// Absolute rounding allowance of distances near `p`: boxes are pruned only
+    /// when farther than the best distance plus this, so a triangle whose
+    /// computed distance ties the best is never skipped because of rounding.
+    #[inline]
+    fn slack(&self, p: &[f64; 3]) -> f64 {
+        let m = p.iter().fold(self.coord_scale, |m, c| m.max(c.abs()));
+        1e-12 * m
+    }
+
+    /// Scans the primitives of leaf `leaf`.
+    #[inline]
+    fn scan_leaf(&self, leaf: usize, p: &[f64; 3], best: &mut Best, keep: &impl Fn(u32) -> bool) {
+        let n = &self.nodes[leaf];
+        let s = n.start as usize;
+        for slot in s..s + n.count as usize {
+            let tri = self.prim_triangle[slot];
+            if keep(tri) {
+                let c = &self.prim_corners[slot];
+                best.offer(tri, closest_point_triangle(*p, c[0], c[1], c[2]));
+            }
+        }
+    }
+
+    /// Top-down search from the root (whose box the caller checked).
+    fn descend(&self, p: &[f64; 3], best: &mut Best, keep: &impl Fn(u32) -> bool) {
         let mut stack = [(0u32, 0f64); MAX_DEPTH];
         let mut sp = 0usize;
         let mut node = 0usize;
-        if self.nodes[0].bbox.distance2(&p) > best_d2 {
-            return (best_tri != u32::MAX).then_some(ClosestHit {
-                triangle: best_tri,
-                closest: best_cp,
-            });
-        }
         loop {
             let n = &self.nodes[node];
             if n.is_leaf() {
-                let s = n.start as usize;
-                for slot in s..s + n.count as usize {
-                    let tri = self.prim_triangle[slot];
-                    if !keep(tri) {
-                        continue;
-                    }
-                    let c = &self.prim_corners[slot];
-                    let cp = closest_point_triangle(p, c[0], c[1], c[2]);
-                    if cp.dist2 < best_d2 || (cp.dist2 == best_d2 && tri < best_tri) {
-                        best_d2 = cp.dist2;
-                        best_tri = tri;
-                        best_cp = cp;
-                    }
-                }
+                self.scan_leaf(node, p, best, keep);
             } else {
                 let (l, r) = (node + 1, n.start as usize);
-                let dl = self.nodes[l].bbox.distance2(&p);
-                let dr = self.nodes[r].bbox.distance2(&p);
+                let dl = self.nodes[l].bbox.distance2(p);
+                let dr = self.nodes[r].bbox.distance2(p);
                 let (near, dn, far, df) = if dl <= dr {
                     (l, dl, r, dr)
                 } else {
                     (r, dr, l, dl)
                 };
-                if dn <= best_d2 {
-                    if df <= best_d2 {
+                if dn <= best.limit {
+                    if df <= best.limit {
                         stack[sp] = (far as u32, df);
                         sp += 1;
                     }
@@ -247,7 +363,7 @@ impl Bvh {
             while sp > 0 {
                 sp -= 1;
                 let (nd, d) = stack[sp];
-                if d <= best_d2 {
+                if d <= best.limit {
                     next = Some(nd as usize);
                     break;
                 }
@@ -257,10 +373,6 @@ impl Bvh {
                 None => break,
             }
         }
-        (best_tri != u32::MAX).then_some(ClosestHit {
-            triangle: best_tri,
-            closest: best_cp,
-        })
     }
 
     /// For per-triangle values `tri_min`, the minimum over each node's subtree
@@ -485,6 +597,44 @@ mod tests {
             assert_eq!(hinted, hit);
             assert!(dist2(hit.closest.point, p) == hit.closest.dist2);
         }
+    }
+
+    #[test]
+    fn any_within_agrees_with_the_closest_distance() {
+        let (v, t) = random_soup(2000, 4);
+        let bvh = Bvh::build(&v, &t);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let (mut yes, mut no) = (0, 0);
+        for _ in 0..400 {
+            let p = [
+                rng.gen_range(-0.5..1.5),
+                rng.gen_range(-0.5..1.5),
+                rng.gen_range(-0.5..1.5),
+            ];
+            let d2 = bvh.closest(p, None).unwrap().closest.dist2;
+            let r2 = d2 * rng.gen_range(0.5..1.5);
+            let hint = rng.gen_bool(0.5).then(|| rng.gen_range(0..2000));
+            match bvh.any_within(p, r2, hint) {
+                Some(tri) => {
+                    yes += 1;
+                    assert!(d2 <= r2);
+                    let c = t[tri as usize].map(|i| v[i as usize]);
+                    assert!(closest_point_triangle(p, c[0], c[1], c[2]).dist2 <= r2);
+                }
+                None => {
+                    no += 1;
+                    assert!(d2 > r2);
+                }
+            }
+            assert!(
+                bvh.any_within(p, d2, None).is_some(),
+                "the closest is within"
+            );
+        }
+        assert!(yes > 50 && no > 50, "both answers exercised: {yes} / {no}");
+        assert!(Bvh::build(&v, &[])
+            .any_within([0.0; 3], 1.0, None)
+            .is_none());
     }
 
     #[test]
