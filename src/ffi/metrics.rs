@@ -229,7 +229,10 @@ pub unsafe extern "C" fn abgs_hausdorff(
 /// One-sided Hausdorff distance from the surface of `from` to that of `to` into
 /// `*out_distance`: the largest exact distance to `to` over `samples`
 /// area-uniform points of `from` (with `seed`) and every vertex of `from`.
-/// Sizes are not needed. Parallel, deterministic. O((samples + V_from) log F_to).
+/// Sizes are not needed. Parallel, deterministic (the exact maximum whatever
+/// the thread count). O((samples + V_from) log F_to) worst case; a point with a
+/// triangle of `to` within the running maximum is settled by the first such
+/// triangle found, so most points cost one triangle test.
 ///
 /// Errors: NULL, INVALID_ARGUMENT (`samples` is 0), BUSY.
 ///
