@@ -16,6 +16,7 @@ use crate::error::{Error, Result};
 use crate::geometry::*;
 use crate::mesh::Grid;
 use crate::spatial::MAX_DEPTH;
+use arrayvec::ArrayVec;
 use rayon::prelude::*;
 
 /// Answer of a volume query.
@@ -164,8 +165,9 @@ impl Grid {
                 point: add(add(scale(c[0], b[0]), scale(c[1], b[1])), scale(c[2], b[2])),
             };
         }
-        let mut stack = [(0u32, 0f64); MAX_DEPTH];
-        let mut sp = 0;
+        // Uninitialised storage (zeroing a fixed array costs more than the walk);
+        // at most one entry per level, so within capacity.
+        let mut stack: ArrayVec<(u32, f64), MAX_DEPTH> = ArrayVec::new();
         let mut node = 0usize;
         loop {
             let n = &bvh.nodes[node];
@@ -196,18 +198,16 @@ impl Grid {
                 };
                 if bn <= best.size {
                     if bf <= best.size {
-                        stack[sp] = (far as u32, bf);
-                        sp += 1;
+                        stack.push((far as u32, bf));
                     }
                     node = near;
                     continue;
                 }
             }
             let mut next = None;
-            while sp > 0 {
-                sp -= 1;
-                if stack[sp].1 <= best.size {
-                    next = Some(stack[sp].0 as usize);
+            while let Some((nd, b)) = stack.pop() {
+                if b <= best.size {
+                    next = Some(nd as usize);
                     break;
                 }
             }

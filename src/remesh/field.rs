@@ -13,6 +13,7 @@ use crate::mesh::{Features, Grid};
 use crate::sizing::curvature::patch_curvatures;
 use crate::sizing::normals::PatchNormals;
 use crate::spatial::{Bvh, MAX_DEPTH};
+use arrayvec::ArrayVec;
 use std::f64::consts::PI;
 
 /// Target length across a strip of width w: `STRIP_RATIO · w` (triangles
@@ -260,11 +261,11 @@ impl SourceField {
             return f64::INFINITY;
         }
         let mut best = f64::INFINITY;
-        let mut stack = [0u32; MAX_DEPTH];
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let ni = stack[sp] as usize;
+        // Uninitialised storage; one net entry per level, so within capacity.
+        let mut stack: ArrayVec<u32, { MAX_DEPTH + 1 }> = ArrayVec::new();
+        stack.push(0);
+        while let Some(ni) = stack.pop() {
+            let ni = ni as usize;
             let n = &self.bvh.nodes[ni];
             if self.node_min[ni] + self.slope * n.bbox.distance2(&p).sqrt() >= best {
                 continue;
@@ -277,7 +278,7 @@ impl SourceField {
                     let d = closest_point_triangle(p, a, b, c).dist2.sqrt();
                     best = best.min(self.value[i] + self.slope * d);
                 }
-            } else if sp + 2 <= MAX_DEPTH {
+            } else {
                 let (l, r) = (ni + 1, n.start as usize);
                 let dl =
                     self.node_min[l] + self.slope * self.bvh.nodes[l].bbox.distance2(&p).sqrt();
@@ -285,9 +286,8 @@ impl SourceField {
                     self.node_min[r] + self.slope * self.bvh.nodes[r].bbox.distance2(&p).sqrt();
                 // Visit the more promising child first.
                 let (first, second) = if dl <= dr { (l, r) } else { (r, l) };
-                stack[sp] = second as u32;
-                stack[sp + 1] = first as u32;
-                sp += 2;
+                stack.push(second as u32);
+                stack.push(first as u32);
             }
         }
         best

@@ -10,6 +10,7 @@
 //! traversal order or a hint. Expected O(log F) for points near the surface.
 
 use crate::geometry::{closest_point_triangle, Aabb, ClosestPoint};
+use arrayvec::ArrayVec;
 /// Largest leaf the SAH may choose.
 const MAX_LEAF: usize = 4;
 /// SAH bins per split.
@@ -65,11 +66,12 @@ struct Best {
     d2: f64,
     /// Boxes farther than this (squared) are pruned: `d2` plus rounding slack.
     limit: f64,
-    slack: f64,
+    /// Rounding allowance of squared distances (see [`Bvh::pad`]).
+    pad: f64,
 }
 
 impl Best {
-    fn new(p: [f64; 3], bound2: f64, slack: f64) -> Best {
+    fn new(p: [f64; 3], bound2: f64, pad: f64) -> Best {
         Best {
             tri: u32::MAX,
             cp: ClosestPoint {
@@ -78,8 +80,8 @@ impl Best {
                 dist2: f64::INFINITY,
             },
             d2: bound2,
-            limit: padded(bound2, slack),
-            slack,
+            limit: padded(bound2, pad),
+            pad,
         }
     }
 
@@ -89,7 +91,7 @@ impl Best {
     fn offer(&mut self, tri: u32, cp: ClosestPoint) {
         if cp.dist2 < self.d2 || (cp.dist2 == self.d2 && tri < self.tri) {
             if cp.dist2 != self.d2 {
-                self.limit = padded(cp.dist2, self.slack);
+                self.limit = padded(cp.dist2, self.pad);
             }
             self.d2 = cp.dist2;
             self.tri = tri;
@@ -98,11 +100,11 @@ impl Best {
     }
 }
 
-/// `(sqrt(d2) + slack)^2`, rounded up a little; infinity stays infinity.
-#[inline]
-fn padded(d2: f64, slack: f64) -> f64 {
-    let r = d2.sqrt() + slack;
-    r * r * (1.0 + 1e-12)
+/// `d2` grown by the allowance `pad` of [`Bvh::pad`] (no square root on the
+/// search's critical path); infinity stays infinity.
+#[inline(always)]
+fn padded(d2: f64, pad: f64) -> f64 {
+    d2 * (1.0 + 1e-12) + pad
 }
 
 /// Result of a closest-point query.
@@ -237,7 +239,7 @@ impl Bvh {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best = Best::new(p, bound2, self.slack(&p));
+        let mut best = Best::new(p, bound2, self.pad(&p));
         // In range first: `keep` may index by triangle.
         if let Some(h) = hint.filter(|&h| (h as usize) < self.triangle_prim.len() && keep(h)) {
             let c = &self.prim_corners[self.triangle_prim[h as usize] as usize];
@@ -270,15 +272,14 @@ impl Bvh {
                 return hint;
             }
         }
-        let limit = padded(r2, self.slack(&p));
+        let limit = padded(r2, self.pad(&p));
         if self.nodes[0].bbox.distance2(&p) > limit {
             return None;
         }
-        let mut stack = [0u32; MAX_DEPTH + 1];
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let ni = stack[sp] as usize;
+        let mut stack: ArrayVec<u32, { MAX_DEPTH + 1 }> = ArrayVec::new();
+        stack.push(0);
+        while let Some(ni) = stack.pop() {
+            let ni = ni as usize;
             let n = &self.nodes[ni];
             if n.is_leaf() {
                 let s = n.start as usize;
@@ -296,25 +297,33 @@ impl Bvh {
             } else {
                 (r, dr, l, dl)
             };
+            // One net entry per level: within capacity by the depth bound.
             if df <= limit {
-                stack[sp] = far as u32;
-                sp += 1;
+                stack.push(far as u32);
             }
             if dn <= limit {
-                stack[sp] = near as u32;
-                sp += 1;
+                stack.push(near as u32);
             }
         }
         None
     }
 
-    /// Absolute rounding allowance of distances near `p`: boxes are pruned only
-    /// when farther than the best distance plus this, so a triangle whose
-    /// computed distance ties the best is never skipped because of rounding.
+    /// Rounding allowance of squared distances near `p`. Distances computed
+    /// near `p` err by far less than `s = 1e-12 · max |coordinate|`, so a box is
+    /// pruned only when farther than `(√d2 + s)²` for the best `d2`: a triangle
+    /// whose computed distance ties the best is never skipped. As `√d2 ≤ R`,
+    /// the largest distance from `p` to the root box, `(√d2 + s)² ≤ d2 + s(2R + s)`,
+    /// the returned `s(2R + s)`.
     #[inline]
-    fn slack(&self, p: &[f64; 3]) -> f64 {
-        let m = p.iter().fold(self.coord_scale, |m, c| m.max(c.abs()));
-        1e-12 * m
+    fn pad(&self, p: &[f64; 3]) -> f64 {
+        let s = 1e-12 * p.iter().fold(self.coord_scale, |m, c| m.max(c.abs()));
+        let b = &self.nodes[0].bbox;
+        let mut r2 = 0.0;
+        for k in 0..3 {
+            let f = (p[k] - b.min[k]).abs().max((p[k] - b.max[k]).abs());
+            r2 += f * f;
+        }
+        s * (2.0 * r2.sqrt() * (1.0 + 1e-12) + s)
     }
 
     /// Scans the primitives of leaf `leaf`.
@@ -333,8 +342,8 @@ impl Bvh {
 
     /// Top-down search from the root (whose box the caller checked).
     fn descend(&self, p: &[f64; 3], best: &mut Best, keep: &impl Fn(u32) -> bool) {
-        let mut stack = [(0u32, 0f64); MAX_DEPTH];
-        let mut sp = 0usize;
+        // Uninitialised storage: zeroing a fixed array costs more than the walk.
+        let mut stack: ArrayVec<(u32, f64), MAX_DEPTH> = ArrayVec::new();
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
@@ -351,8 +360,8 @@ impl Bvh {
                 };
                 if dn <= best.limit {
                     if df <= best.limit {
-                        stack[sp] = (far as u32, df);
-                        sp += 1;
+                        // At most one entry per level: the depth bound keeps it in capacity.
+                        stack.push((far as u32, df));
                     }
                     node = near;
                     continue;
@@ -360,9 +369,7 @@ impl Bvh {
             }
             // Pop the next node still within the bound.
             let mut next = None;
-            while sp > 0 {
-                sp -= 1;
-                let (nd, d) = stack[sp];
+            while let Some((nd, d)) = stack.pop() {
                 if d <= best.limit {
                     next = Some(nd as usize);
                     break;

@@ -2,6 +2,7 @@
 
 use super::bvh::{Bvh, MAX_DEPTH};
 use crate::geometry::{cross, dot, sub, Aabb};
+use arrayvec::ArrayVec;
 
 /// Entry parameter of the ray into `b` within `[t0, t1]`, or `None` if it misses.
 #[inline(always)]
@@ -79,14 +80,11 @@ impl Bvh {
         let inv = [1.0 / d[0], 1.0 / d[1], 1.0 / d[2]];
         let mut best: Option<(u32, f64)> = None;
         let mut best_t = tmax;
-        let mut stack = [(0u32, 0f64); MAX_DEPTH];
-        let mut sp = 0;
+        // Uninitialised storage; one net entry per level, so within capacity.
+        let mut stack: ArrayVec<(u32, f64), { MAX_DEPTH + 1 }> = ArrayVec::new();
         let t_root = slab(&self.nodes[0].bbox, o, inv, tmin, best_t)?;
-        stack[sp] = (0, t_root);
-        sp += 1;
-        while sp > 0 {
-            sp -= 1;
-            let (ni, t_enter) = stack[sp];
+        stack.push((0, t_root));
+        while let Some((ni, t_enter)) = stack.pop() {
             if t_enter > best_t {
                 continue;
             }
@@ -116,18 +114,11 @@ impl Bvh {
                         } else {
                             ((l, a), (r, b))
                         };
-                        stack[sp] = (f as u32, tf);
-                        stack[sp + 1] = (nn as u32, tn);
-                        sp += 2;
+                        stack.push((f as u32, tf));
+                        stack.push((nn as u32, tn));
                     }
-                    (Some(a), None) => {
-                        stack[sp] = (l as u32, a);
-                        sp += 1;
-                    }
-                    (None, Some(b)) => {
-                        stack[sp] = (r as u32, b);
-                        sp += 1;
-                    }
+                    (Some(a), None) => stack.push((l as u32, a)),
+                    (None, Some(b)) => stack.push((r as u32, b)),
                     (None, None) => {}
                 }
             }
