@@ -11,6 +11,7 @@
 
 use crate::geometry::{closest_point_triangle, Aabb, ClosestPoint};
 use arrayvec::ArrayVec;
+
 /// Largest leaf the SAH may choose.
 const MAX_LEAF: usize = 4;
 /// SAH bins per split.
