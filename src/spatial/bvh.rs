@@ -290,14 +290,7 @@ impl Bvh {
                 continue;
             }
             // Children within reach, the nearer popped first.
-            let (l, r) = (ni + 1, n.start as usize);
-            let dl = self.nodes[l].bbox.distance2(&p);
-            let dr = self.nodes[r].bbox.distance2(&p);
-            let (near, dn, far, df) = if dl <= dr {
-                (l, dl, r, dr)
-            } else {
-                (r, dr, l, dl)
-            };
+            let (near, dn, far, df) = self.children_by_distance(ni, &p);
             // One net entry per level: within capacity by the depth bound.
             if df <= limit {
                 stack.push(far as u32);
@@ -341,6 +334,20 @@ impl Bvh {
         }
     }
 
+    /// The two children of inner node `node` as (nearer, its squared box
+    /// distance to `p`, farther, its distance); ties to the left child.
+    #[inline(always)]
+    fn children_by_distance(&self, node: usize, p: &[f64; 3]) -> (usize, f64, usize, f64) {
+        let (l, r) = (node + 1, self.nodes[node].start as usize);
+        let dl = self.nodes[l].bbox.distance2(p);
+        let dr = self.nodes[r].bbox.distance2(p);
+        if dl <= dr {
+            (l, dl, r, dr)
+        } else {
+            (r, dr, l, dl)
+        }
+    }
+
     /// Top-down search from the root (whose box the caller checked).
     fn descend(&self, p: &[f64; 3], best: &mut Best, keep: &impl Fn(u32) -> bool) {
         // Uninitialised storage: zeroing a fixed array costs more than the walk.
@@ -351,14 +358,7 @@ impl Bvh {
             if n.is_leaf() {
                 self.scan_leaf(node, p, best, keep);
             } else {
-                let (l, r) = (node + 1, n.start as usize);
-                let dl = self.nodes[l].bbox.distance2(p);
-                let dr = self.nodes[r].bbox.distance2(p);
-                let (near, dn, far, df) = if dl <= dr {
-                    (l, dl, r, dr)
-                } else {
-                    (r, dr, l, dl)
-                };
+                let (near, dn, far, df) = self.children_by_distance(node, p);
                 if dn <= best.limit {
                     if df <= best.limit {
                         // At most one entry per level: the depth bound keeps it in capacity.
