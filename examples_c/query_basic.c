@@ -61,7 +61,7 @@ int main(int argc, char **argv) {
     double *points = NULL;
     size_t n_points = 0;
 
-    abgs_grid_stats stats;
+    abgs_grid_stats stats = {.struct_size = sizeof stats};
     if (!check(abgs_grid_get_stats(grid, &stats), "abgs_grid_get_stats")) {
         goto done;
     }

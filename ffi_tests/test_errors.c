@@ -51,7 +51,7 @@ int main(int argc, char **argv) {
     double p[3] = {0.5, 0.5, 0.5}, s = -1.0;
     CHECK_STATUS(abgs_query_size(g, p, &s), ABGS_ERR_NO_SIZES);
     CHECK(s == -1.0);
-    abgs_hit hit;
+    abgs_hit hit = {.struct_size = sizeof hit};
     CHECK_STATUS(abgs_query_closest(g, p, ABGS_NO_HINT, &hit), ABGS_OK);
     CHECK(hit.distance == 0.5 && isnan(hit.size));
     double sc[NV];

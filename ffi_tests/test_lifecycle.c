@@ -19,7 +19,7 @@ int main(int argc, char **argv) {
     abgs_grid *g = NULL;
     CHECK_STATUS(abgs_grid_from_arrays(xyz, NV, tris, NT, sizes, &g), ABGS_OK);
     CHECK(g != NULL);
-    abgs_grid_stats st;
+    abgs_grid_stats st = {.struct_size = sizeof st};
     CHECK_STATUS(abgs_grid_get_stats(g, &st), ABGS_OK);
     CHECK(st.vertices == NV && st.triangles == NT && st.bodies == 1);
     CHECK(st.boundary_edges == 4 * N && st.non_manifold_edges == 0);

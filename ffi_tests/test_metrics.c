@@ -23,7 +23,7 @@ int main(void) {
     linear_sizes(xc, NVC, hc);
     for (int i = 0; i < NVF; i++) h2[i] = 2.0 * hf[i];
 
-    abgs_eval_params p;
+    abgs_eval_params p = {.struct_size = sizeof p};
     CHECK_STATUS(abgs_eval_params_default(&p), ABGS_OK);
     CHECK(p.samples == 100000 && p.hausdorff_samples == 100000 && p.seed == 1);
     CHECK_STATUS(abgs_eval_params_default(NULL), ABGS_ERR_NULL);
@@ -50,8 +50,7 @@ int main(void) {
     CHECK_STATUS(abgs_grid_from_arrays(xs, NVF, tf, NTF, NULL, &patch), ABGS_OK);
 
     /* A grid against itself: nothing changes. */
-    abgs_evaluation e;
-    memset(&e, 0, sizeof e);
+    abgs_evaluation e = {.struct_size = sizeof e};
     CHECK_STATUS(abgs_evaluate(fine, fine, &p, &e), ABGS_OK);
     CHECK(e.faces_reference == NTF && e.faces_candidate == NTF);
     CHECK(e.vertices_reference == NVF && e.vertices_candidate == NVF);
@@ -87,7 +86,7 @@ int main(void) {
     CHECK(near(e.element_count_change, -0.75, 1e-12));
 
     /* Deterministic: the same call gives the same bits. */
-    abgs_evaluation e2;
+    abgs_evaluation e2 = {.struct_size = sizeof e2};
     CHECK_STATUS(abgs_evaluate(fine, doubled, &p, &e2), ABGS_OK);
     CHECK(e2.size_deviation_mean == e.size_deviation_mean && e2.element_count_candidate == e.element_count_candidate);
 

@@ -51,7 +51,7 @@ int main(void) {
         CHECK(abgs_query_size(g, p, &s1) == ABGS_OK);
         CHECK(abgs_query_size_hinted(g, p, &hint, &s2) == ABGS_OK);
         if (memcmp(&s1, &s2, sizeof s1) != 0) same = 0;
-        abgs_hit h;
+        abgs_hit h = {.struct_size = sizeof h};
         CHECK(abgs_query_closest(g, p, ABGS_NO_HINT, &h) == ABGS_OK);
         if (fabs(h.size - field(h.point)) > 1e-12 * field(h.point) || memcmp(&h.size, &s1, sizeof s1) != 0) at_closest = 0;
         single[k] = s1;
@@ -68,7 +68,7 @@ int main(void) {
     double beta = 1.2, vol[M];
     int bounded = 1;
     for (int k = 0; k < M; k++) {
-        abgs_hit h;
+        abgs_hit h = {.struct_size = sizeof h};
         double v = 0;
         CHECK(abgs_query_closest(g, &pts[3 * k], ABGS_NO_HINT, &h) == ABGS_OK);
         CHECK(abgs_query_size_volume(g, &pts[3 * k], beta, &v) == ABGS_OK);

@@ -48,7 +48,7 @@ static void copy_out(const abgs_grid *g, size_t *nv, size_t *nt, double **xyz, u
 }
 
 int main(void) {
-    abgs_remesh_params p;
+    abgs_remesh_params p = {.struct_size = sizeof p};
     CHECK_STATUS(abgs_remesh_params_default(&p), ABGS_OK);
     CHECK(p.edge_length == 0.0 && p.relative_length == 0.01 && p.feature_angle_deg == 30.0);
     CHECK(p.iterations == 10 && p.curvature_limit == 1 && p.n_circle == 24.0);
@@ -61,6 +61,7 @@ int main(void) {
     p.edge_length = 0.1;
     abgs_remesh_report r;
     memset(&r, 0xff, sizeof r);
+    r.struct_size = sizeof r;
     abgs_grid *dense = NULL;
     CHECK_STATUS(abgs_grid_remesh(cube, NULL, &p, &dense, &r), ABGS_OK);
     CHECK(dense != NULL);
@@ -86,7 +87,7 @@ int main(void) {
     }
     CHECK(all_on);
     CHECK(corners == 8); /* corners never move and are never removed */
-    abgs_grid_stats st;
+    abgs_grid_stats st = {.struct_size = sizeof st};
     CHECK_STATUS(abgs_grid_get_stats(dense, &st), ABGS_OK);
     CHECK(st.bodies == 1 && st.boundary_edges == 0 && st.non_manifold_edges == 0);
     CHECK(st.has_sizes == 0);
@@ -277,6 +278,7 @@ int main(void) {
     CHECK(o == NULL);
     /* A failed call leaves the report untouched. */
     memset(&r, 0, sizeof r);
+    r.struct_size = sizeof r;
     bad = p; bad.iterations = 0;
     CHECK_STATUS(abgs_grid_remesh(cube, NULL, &bad, &o, &r), ABGS_ERR_INVALID_ARGUMENT);
     CHECK(r.faces_out == 0 && r.n_issues == 0);

@@ -13,6 +13,9 @@ struct progress_state {
     int calls;
     int stop_after;
     uint64_t last_faces;
+    abgs_grid *input; /* the grid being simplified, read-held by the call */
+    const double *sizes;
+    int busy_checked;
 };
 
 static int32_t on_progress(const abgs_iteration_record *r, void *user) {
@@ -21,16 +24,32 @@ static int32_t on_progress(const abgs_iteration_record *r, void *user) {
     CHECK(r != NULL && r->iteration == (uint64_t)s->calls);
     CHECK(r->faces < NT && r->accepted > 0 && r->element_count > 0.0);
     s->last_faces = r->faces;
+    CHECK(r->struct_size == sizeof *r);
+    if (s->input != NULL) {
+        /* The call holds its input: mutating it or freeing it is BUSY (and
+           frees nothing), reading it still works. */
+        CHECK_STATUS(abgs_grid_set_sizes(s->input, s->sizes, NV), ABGS_ERR_BUSY);
+        CHECK(strstr(abgs_last_error_message(), "in use") != NULL);
+        CHECK_STATUS(abgs_grid_free(s->input), ABGS_ERR_BUSY);
+        double q = 0.0, mid[3] = {0.5, 0.5, 0.0};
+        CHECK_STATUS(abgs_query_size(s->input, mid, &q), ABGS_OK);
+        s->busy_checked++;
+    }
     return s->stop_after > 0 && s->calls >= s->stop_after;
 }
 
 int main(void) {
-    abgs_simplify_params p;
+    abgs_simplify_params p = {.struct_size = sizeof p};
     CHECK_STATUS(abgs_simplify_params_default(&p), ABGS_OK);
     CHECK(p.method == ABGS_METHOD_LBO && p.fraction == 0.10 && p.pool_factor == 2.0);
     CHECK(p.t_size == 1.2 && p.tau_d == 0.05 && p.max_distance == 0.0);
     CHECK(p.max_iterations == 200 && p.repair == 1 && p.progress == NULL);
     CHECK_STATUS(abgs_simplify_params_default(NULL), ABGS_ERR_NULL);
+    /* A struct whose struct_size was not set is refused, not overrun. */
+    abgs_simplify_params z = {0};
+    CHECK_STATUS(abgs_simplify_params_default(&z), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(abgs_last_error_message(), "struct_size") != NULL);
+    CHECK(z.struct_size == 0 && z.fraction == 0.0);
 
     static double xyz[3 * NV];
     static uint32_t tris[3 * NT];
@@ -46,10 +65,10 @@ int main(void) {
     CHECK_STATUS(abgs_grid_set_sizes(dense, h, NV), ABGS_OK);
 
     /* Full run with a progress callback. */
-    struct progress_state st = {0, 0, 0};
+    struct progress_state st = {0, 0, 0, dense, h, 0};
     p.progress = on_progress;
     p.user_data = &st;
-    abgs_simplify_report r;
+    abgs_simplify_report r = {.struct_size = sizeof r};
     CHECK_STATUS(abgs_simplify(dense, &p, &out, &r), ABGS_OK);
     CHECK(out != NULL);
     CHECK(r.faces_in == NT && r.vertices_in == NV);
@@ -57,6 +76,7 @@ int main(void) {
     CHECK(r.stop == ABGS_STOP_CONVERGED);
     CHECK(r.iterations >= 2 && (int)r.iterations == st.calls + 1); /* the last selected nothing */
     CHECK(r.corners == 4 && r.feature_lines >= 4);
+    CHECK(st.busy_checked == st.calls && r.struct_size == sizeof r);
     CHECK(r.element_count_in > 0.0 && fabs(r.element_count_out / r.element_count_in - 1.0) < 0.1);
     size_t nt = 0, nv = 0;
     CHECK_STATUS(abgs_grid_triangle_count(out, &nt), ABGS_OK);
@@ -67,7 +87,7 @@ int main(void) {
     double mid[3] = {0.5, 0.5, 0.0};
     CHECK_STATUS(abgs_query_size(out, mid, &q), ABGS_OK);
     CHECK(fabs(q / 0.12 - 1.0) < 0.2);
-    abgs_iteration_record rec;
+    abgs_iteration_record rec = {.struct_size = sizeof rec};
     CHECK_STATUS(abgs_grid_simplify_iteration(out, 0, &rec), ABGS_OK);
     CHECK(rec.iteration == 1 && rec.accepted > 0 && rec.candidates >= rec.collapsible);
     CHECK_STATUS(abgs_grid_simplify_iteration(out, (size_t)r.iterations - 1, &rec), ABGS_OK);
@@ -78,7 +98,7 @@ int main(void) {
 
     /* Cancel after two iterations: a valid, partly simplified grid. */
     abgs_grid *part = NULL;
-    struct progress_state st2 = {0, 2, 0};
+    struct progress_state st2 = {0, 2, 0, NULL, NULL, 0};
     p.user_data = &st2;
     CHECK_STATUS(abgs_simplify(dense, &p, &part, &r), ABGS_OK);
     CHECK(part != NULL && r.stop == ABGS_STOP_CANCELLED && r.iterations == 2 && st2.calls == 2);
@@ -127,6 +147,15 @@ int main(void) {
     bad.method = ABGS_METHOD_GCN;
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_NOT_AVAILABLE);
     CHECK(none == NULL);
+    bad.method = 7; /* no such method: checked, never taken as an enum */
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(abgs_last_error_message(), "method = 7") != NULL);
+    bad = p;
+    bad.struct_size = 0;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    abgs_simplify_report rz = {0};
+    CHECK_STATUS(abgs_simplify(dense, &p, &none, &rz), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(none == NULL && rz.faces_out == 0);
     bad = p;
     bad.t_size = NAN;
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_NON_FINITE);

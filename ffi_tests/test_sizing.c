@@ -12,7 +12,7 @@ int main(void) {
     make_plate(N, xyz, tris);
     for (int i = 0; i < NV; i++) xyz[3 * i + 2] = 0.05 * sin(8.0 * xyz[3 * i]);
 
-    abgs_size_params p;
+    abgs_size_params p = {.struct_size = sizeof p};
     CHECK_STATUS(abgs_size_params_default(&p), ABGS_OK);
     CHECK(p.n_circle == 24.0 && p.n_gap == 3.0 && p.beta == 1.2 && p.slope == 0.0);
     CHECK(p.hmin == 0.0 && p.hmax == 0.0 && p.feature_angle_deg == 30.0);
@@ -28,11 +28,11 @@ int main(void) {
     CHECK_STATUS(abgs_lbo(g, lv, NV, NULL, 0), ABGS_ERR_NO_SIZES);
 
     /* Compute with a point source in the middle. */
-    abgs_size_source src = {ABGS_SOURCE_POINT, {0.5, 0.5, 0.05 * sin(4.0), 0, 0, 0, 0, 0, 0}, 0.002, 0.05};
+    abgs_size_source src = {.struct_size = sizeof src, .kind = ABGS_SOURCE_POINT,
+                           .points = {0.5, 0.5, 0.05 * sin(4.0)}, .size = 0.002, .radius = 0.05};
     p.sources = &src;
     p.n_sources = 1;
-    abgs_size_report r;
-    memset(&r, 0, sizeof r);
+    abgs_size_report r = {.struct_size = sizeof r};
     CHECK_STATUS(abgs_compute_size(g, &p, &r), ABGS_OK);
     CHECK(r.hmin > 0.0 && r.hmax > r.hmin && fabs(r.slope - log(1.2)) < 1e-15);
     CHECK(r.limited_by_source >= 1 && r.limited_by_curvature > 0);

@@ -49,7 +49,8 @@ int main(int argc, char **argv) {
                              "[--max-normal-deviation DEG]\n");
         return 2;
     }
-    abgs_eval_params ep;
+    abgs_eval_params ep{};
+    ep.struct_size = sizeof ep;
     check(abgs_eval_params_default(&ep), "abgs_eval_params_default");
     ep.samples = ep.hausdorff_samples = static_cast<uint64_t>(args.num("samples", 100000));
     ep.seed = static_cast<uint64_t>(args.num("seed", 1));
@@ -113,6 +114,8 @@ int main(int argc, char **argv) {
     const double om_reproject = now() - t0;
 
     abgs_evaluation e_om{}, e_abgs{};
+
+    e_om.struct_size = e_abgs.struct_size = sizeof(abgs_evaluation);
     check(abgs_evaluate(dense.g, om.g, &ep, &e_om), "abgs_evaluate (OpenMesh)");
     check(abgs_evaluate(dense.g, simp.g, &ep, &e_abgs), "abgs_evaluate (abgs)");
 

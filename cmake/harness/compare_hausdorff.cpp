@@ -119,7 +119,8 @@ int main(int argc, char **argv) {
         uint32_t hint = ABGS_NO_HINT;
         for (const auto &p : pts) {
             const double q[3] = {p.x(), p.y(), p.z()};
-            abgs_hit hit;
+            abgs_hit hit{};
+            hit.struct_size = sizeof hit;
             check(abgs_query_closest(target.g, q, hint, &hit), "abgs_query_closest");
             hint = hit.triangle;
             m = std::max(m, hit.distance);

@@ -304,7 +304,8 @@ int main(int argc, char **argv) {
             unexplained++;
             max_rel_untied = std::max(max_rel_untied, r);
             if (unexplained <= 5) {
-                abgs_hit hit;
+                abgs_hit hit{};
+                hit.struct_size = sizeof hit;
                 check(abgs_query_closest(g.g, &pts[3 * i], ABGS_NO_HINT, &hit), "abgs_query_closest");
                 Hint h = cg.tree.closest_point_and_primitive(cpts[i]);
                 std::fprintf(stderr,

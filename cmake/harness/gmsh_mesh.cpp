@@ -182,7 +182,8 @@ int main(int argc, char **argv) {
         size_t s = dense_path.find_last_of('/');
         work = s == std::string::npos ? "." : dense_path.substr(0, s);
     }
-    abgs_eval_params ep;
+    abgs_eval_params ep{};
+    ep.struct_size = sizeof ep;
     check(abgs_eval_params_default(&ep), "abgs_eval_params_default");
     ep.samples = ep.hausdorff_samples = static_cast<uint64_t>(args.num("samples", 100000));
 
@@ -190,14 +191,16 @@ int main(int argc, char **argv) {
     dense.load(dense_path);
     simp.load(args.str("simplified", ""));
     stl.load(args.str("stl", ""));
-    abgs_size_params sp;
+    abgs_size_params sp{};
+    sp.struct_size = sizeof sp;
     check(abgs_size_params_default(&sp), "abgs_size_params_default");
-    abgs_size_report sr{};
+    abgs_size_report sr{sizeof(abgs_size_report)};
     double t0 = now();
     check(abgs_compute_size(stl.g, &sp, &sr), "abgs_compute_size (STL)");
     const double stl_size_seconds = now() - t0;
     stl.refresh();
     abgs_evaluation e_simp{}, e_stl{};
+    e_simp.struct_size = e_stl.struct_size = sizeof(abgs_evaluation);
     check(abgs_evaluate(dense.g, simp.g, &ep, &e_simp), "abgs_evaluate (simplified)");
     check(abgs_evaluate(dense.g, stl.g, &ep, &e_stl), "abgs_evaluate (STL)");
     const std::string msh = work + "/dense_background.msh";

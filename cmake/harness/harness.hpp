@@ -44,7 +44,7 @@ struct Grid {
     std::vector<double> xyz;     // 3 per vertex
     std::vector<uint32_t> tri;   // 3 per triangle
     std::vector<double> size;    // 1 per vertex (empty without sizes)
-    abgs_grid_stats stats{};
+    abgs_grid_stats stats{sizeof(abgs_grid_stats)};
 
     Grid() = default;
     Grid(const Grid &) = delete;

@@ -23,7 +23,7 @@ pub enum abgs_status {
     ABGS_OK = 0,
     /// A required pointer is NULL.
     ABGS_ERR_NULL = 1,
-    /// An argument is malformed (counts, lengths, options).
+    /// An argument is malformed (counts, lengths, options, struct_size).
     ABGS_ERR_INVALID_ARGUMENT = 2,
     /// An index is out of range (e.g. a triangle names a missing vertex).
     ABGS_ERR_OUT_OF_RANGE = 3,
@@ -43,7 +43,7 @@ pub enum abgs_status {
     ABGS_ERR_EMPTY = 10,
     /// The grid has no sizes yet.
     ABGS_ERR_NO_SIZES = 11,
-    /// A mutating call met a grid in use by another call.
+    /// A call met a grid in use by another call (a mutation, or a free, against any use).
     ABGS_ERR_BUSY = 12,
     /// The caller's progress callback asked to stop.
     ABGS_ERR_CANCELLED = 13,
@@ -51,6 +51,65 @@ pub enum abgs_status {
     ABGS_ERR_NOT_AVAILABLE = 14,
     /// A bug in abgs (a caught panic); the message says where.
     ABGS_ERR_INTERNAL = 99,
+}
+
+/// Names, descriptions and the list of every status, from one table: the
+/// `match`es it makes are exhaustive, so a status added to the enum without a
+/// row here does not compile, and `tests::header_status_docs_are_the_descriptions`
+/// fails when a variant's doc comment (the header's text) differs from its row.
+macro_rules! status_table {
+    ($($v:ident => $msg:literal,)*) => {
+        impl abgs_status {
+            /// Every status, in declaration order.
+            pub const ALL: &'static [abgs_status] = &[$(abgs_status::$v),*];
+
+            /// The status's name as the header spells it, e.g. `ABGS_ERR_NULL`.
+            pub const fn name(self) -> &'static CStr {
+                match self {
+                    $(abgs_status::$v => cstr(concat!(stringify!($v), "\0")),)*
+                }
+            }
+
+            /// One line saying what the status means (the header's comment).
+            pub const fn description(self) -> &'static CStr {
+                match self {
+                    $(abgs_status::$v => cstr(concat!($msg, "\0")),)*
+                }
+            }
+
+            /// The status with number `n`, if there is one.
+            pub fn from_int(n: c_int) -> Option<abgs_status> {
+                Self::ALL.iter().copied().find(|s| *s as c_int == n)
+            }
+        }
+    };
+}
+
+/// A `&CStr` from a literal with its NUL (evaluated at compile time).
+const fn cstr(s: &'static str) -> &'static CStr {
+    match CStr::from_bytes_with_nul(s.as_bytes()) {
+        Ok(c) => c,
+        Err(_) => panic!("status text with an inner NUL"),
+    }
+}
+
+status_table! {
+    ABGS_OK => "Success.",
+    ABGS_ERR_NULL => "A required pointer is NULL.",
+    ABGS_ERR_INVALID_ARGUMENT => "An argument is malformed (counts, lengths, options, struct_size).",
+    ABGS_ERR_OUT_OF_RANGE => "An index is out of range (e.g. a triangle names a missing vertex).",
+    ABGS_ERR_NON_FINITE => "A coordinate or parameter is NaN or infinite.",
+    ABGS_ERR_INVALID_SIZE => "A size is not finite and > 0.",
+    ABGS_ERR_IO => "A file could not be opened, read or written.",
+    ABGS_ERR_PARSE => "A file's content is malformed.",
+    ABGS_ERR_UNSUPPORTED_FORMAT => "The file extension names no supported format.",
+    ABGS_ERR_BUFFER_TOO_SMALL => "A caller buffer is too small.",
+    ABGS_ERR_EMPTY => "The grid would have no triangles.",
+    ABGS_ERR_NO_SIZES => "The grid has no sizes yet.",
+    ABGS_ERR_BUSY => "A call met a grid in use by another call (a mutation, or a free, against any use).",
+    ABGS_ERR_CANCELLED => "The caller's progress callback asked to stop.",
+    ABGS_ERR_NOT_AVAILABLE => "The feature is not available in this build.",
+    ABGS_ERR_INTERNAL => "A bug in abgs (a caught panic); the message says where.",
 }
 
 /// An error on its way to C: the status and the message.
@@ -170,6 +229,28 @@ pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, len: usize, what: &str) -> FfiR
     Ok(unsafe { std::slice::from_raw_parts_mut(s.as_ptr() as *mut T, s.len()) })
 }
 
+/// Checks that caller buffers a call reads and writes at once do not overlap
+/// (two live `&mut`, or a `&` and a `&mut`, on the same bytes would be
+/// undefined behaviour in Rust). Each part is (pointer, bytes, name); NULL or
+/// empty parts are skipped.
+pub(crate) fn disjoint(parts: &[(*const u8, usize, &str)]) -> FfiResult<()> {
+    for (i, &(a, na, wa)) in parts.iter().enumerate() {
+        for &(b, nb, wb) in &parts[i + 1..] {
+            let (a0, b0) = (a as usize, b as usize);
+            if a.is_null() || b.is_null() || na == 0 || nb == 0 {
+                continue;
+            }
+            if a0 < b0.saturating_add(nb) && b0 < a0.saturating_add(na) {
+                return err(
+                    abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+                    format!("{wa} and {wb} overlap"),
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Reads three coordinates at `p`.
 ///
 /// # Safety
@@ -216,30 +297,24 @@ pub extern "C" fn abgs_last_error_message() -> *const c_char {
         .unwrap_or(c"abgs: internal error".as_ptr())
 }
 
-/// Name of a status code, e.g. "ABGS_ERR_NULL" ("ABGS_UNKNOWN_STATUS" for others).
-/// Static storage; never NULL.
+/// Name of a status code, e.g. "ABGS_ERR_NULL" ("ABGS_UNKNOWN_STATUS" for a
+/// number that is no status). Static storage; never NULL.
 #[no_mangle]
 pub extern "C" fn abgs_status_name(status: c_int) -> *const c_char {
-    let s: &'static CStr = match status {
-        0 => c"ABGS_OK",
-        1 => c"ABGS_ERR_NULL",
-        2 => c"ABGS_ERR_INVALID_ARGUMENT",
-        3 => c"ABGS_ERR_OUT_OF_RANGE",
-        4 => c"ABGS_ERR_NON_FINITE",
-        5 => c"ABGS_ERR_INVALID_SIZE",
-        6 => c"ABGS_ERR_IO",
-        7 => c"ABGS_ERR_PARSE",
-        8 => c"ABGS_ERR_UNSUPPORTED_FORMAT",
-        9 => c"ABGS_ERR_BUFFER_TOO_SMALL",
-        10 => c"ABGS_ERR_EMPTY",
-        11 => c"ABGS_ERR_NO_SIZES",
-        12 => c"ABGS_ERR_BUSY",
-        13 => c"ABGS_ERR_CANCELLED",
-        14 => c"ABGS_ERR_NOT_AVAILABLE",
-        99 => c"ABGS_ERR_INTERNAL",
-        _ => c"ABGS_UNKNOWN_STATUS",
-    };
-    s.as_ptr()
+    abgs_status::from_int(status)
+        .map_or(c"ABGS_UNKNOWN_STATUS", abgs_status::name)
+        .as_ptr()
+}
+
+/// One line saying what a status means (the header's comment on it), e.g.
+/// "A required pointer is NULL."; "Unknown status." for a number that is no
+/// status. Static storage; never NULL. The message of a particular failure
+/// is `abgs_last_error_message`.
+#[no_mangle]
+pub extern "C" fn abgs_status_description(status: c_int) -> *const c_char {
+    abgs_status::from_int(status)
+        .map_or(c"Unknown status.", abgs_status::description)
+        .as_ptr()
 }
 
 /// The library version as "MAJOR.MINOR.PATCH" (static storage).
@@ -280,10 +355,54 @@ mod tests {
         // SAFETY: the message pointer is valid until the next failing call.
         let m = unsafe { CStr::from_ptr(abgs_last_error_message()) };
         assert!(m.to_str().unwrap().contains("boom"));
-        for code in [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 99] {
+    }
+
+    /// Every number from -1000 to 1000 either is a status, whose name,
+    /// description and number round-trip, or is reported unknown.
+    #[test]
+    fn status_names_and_numbers_round_trip() {
+        let mut seen = 0;
+        for n in -1000..=1000 {
             // SAFETY: static strings.
-            let n = unsafe { CStr::from_ptr(abgs_status_name(code)) };
-            assert!(n.to_str().unwrap().starts_with("ABGS_"));
+            let name = unsafe { CStr::from_ptr(abgs_status_name(n)) }
+                .to_str()
+                .unwrap();
+            // SAFETY: static strings.
+            let desc = unsafe { CStr::from_ptr(abgs_status_description(n)) };
+            match abgs_status::from_int(n) {
+                Some(s) => {
+                    seen += 1;
+                    assert_eq!(s as c_int, n);
+                    assert_eq!(name, format!("{s:?}"), "the name is the variant's");
+                    assert!(desc.to_bytes().ends_with(b"."), "{desc:?}");
+                }
+                None => {
+                    assert_eq!(name, "ABGS_UNKNOWN_STATUS");
+                    assert_eq!(desc, c"Unknown status.");
+                }
+            }
         }
+        assert_eq!(seen, abgs_status::ALL.len());
+    }
+
+    /// The header's enum (generated from the variants' doc comments) names
+    /// every status with its number and the table's description.
+    #[test]
+    fn header_status_docs_are_the_descriptions() {
+        let h = include_str!("../../include/abgs.h");
+        let body = &h[h.find("typedef enum {").unwrap()..h.find("} abgs_status;").unwrap()];
+        let lines: Vec<&str> = body.lines().map(str::trim).collect();
+        let mut n = 0;
+        for (i, l) in lines.iter().enumerate() {
+            let Some((name, num)) = l.strip_suffix(',').and_then(|l| l.split_once(" = ")) else {
+                continue;
+            };
+            let s = abgs_status::from_int(num.parse().unwrap()).unwrap();
+            assert_eq!(s.name().to_str().unwrap(), name);
+            let doc = lines[i - 1].trim_start_matches("// ");
+            assert_eq!(s.description().to_str().unwrap(), doc, "{name}");
+            n += 1;
+        }
+        assert_eq!(n, abgs_status::ALL.len());
     }
 }

@@ -1,95 +1,17 @@
 //! Grid lifecycle, I/O, sizes, statistics and copy-out accessors.
 
 use super::boundary::*;
-use super::remesh::RemeshInfo;
+pub use super::handle::abgs_grid;
+use super::versioned::{check_out, versioned, write_out};
 use crate::mesh::{BuildOptions, Grid};
 use std::ffi::c_char;
-use std::sync::{RwLock, RwLockReadGuard, RwLockWriteGuard, TryLockError};
 
-/// Opaque handle to a background grid. Create with `abgs_grid_from_arrays`,
-/// `abgs_grid_load` or `abgs_grid_remesh`, release with `abgs_grid_free`.
-pub struct abgs_grid {
-    lock: RwLock<Grid>,
-    /// What `abgs_grid_remesh` kept (feature edges) and reported (issues);
-    /// `None` for grids made otherwise. Never changes after creation (no call
-    /// changes a grid's vertices or triangles); read it under [`abgs_grid::read`].
-    remeshed: Option<RemeshInfo>,
-    /// The per-iteration records of `abgs_simplify` for a grid it made
-    /// (empty for grids made otherwise). Never changes after creation.
-    iterations: Vec<super::simplify::abgs_iteration_record>,
-}
-
-impl abgs_grid {
-    /// Shared access for const calls; fails with BUSY while a mutation runs.
-    pub(crate) fn read(&self) -> FfiResult<RwLockReadGuard<'_, Grid>> {
-        match self.lock.try_read() {
-            Ok(g) => Ok(g),
-            Err(TryLockError::WouldBlock) => err(
-                abgs_status::ABGS_ERR_BUSY,
-                "the grid is being modified by another call",
-            ),
-            Err(TryLockError::Poisoned(_)) => err(
-                abgs_status::ABGS_ERR_INTERNAL,
-                "the grid was left unusable by an earlier internal error",
-            ),
-        }
-    }
-
-    /// Exclusive access for mutating calls; fails with BUSY while any other call uses the grid.
-    pub(crate) fn write(&self) -> FfiResult<RwLockWriteGuard<'_, Grid>> {
-        match self.lock.try_write() {
-            Ok(g) => Ok(g),
-            Err(TryLockError::WouldBlock) => err(
-                abgs_status::ABGS_ERR_BUSY,
-                "the grid is in use by another call",
-            ),
-            Err(TryLockError::Poisoned(_)) => err(
-                abgs_status::ABGS_ERR_INTERNAL,
-                "the grid was left unusable by an earlier internal error",
-            ),
-        }
-    }
-
-    fn boxed(g: Grid) -> *mut abgs_grid {
-        Self::boxed_with(g, None)
-    }
-
-    /// A new handle owning `g` and, for a remeshed grid, what the remesher kept.
-    pub(crate) fn boxed_with(g: Grid, remeshed: Option<RemeshInfo>) -> *mut abgs_grid {
-        Box::into_raw(Box::new(abgs_grid {
-            lock: RwLock::new(g),
-            remeshed,
-            iterations: Vec::new(),
-        }))
-    }
-
-    /// A new handle owning a simplified grid and its per-iteration records.
-    pub(crate) fn boxed_simplified(
-        g: Grid,
-        iterations: Vec<super::simplify::abgs_iteration_record>,
-    ) -> *mut abgs_grid {
-        Box::into_raw(Box::new(abgs_grid {
-            lock: RwLock::new(g),
-            remeshed: None,
-            iterations,
-        }))
-    }
-
-    /// The records of the simplification that made this grid (empty otherwise).
-    pub(crate) fn iterations(&self) -> &[super::simplify::abgs_iteration_record] {
-        &self.iterations
-    }
-
-    /// The remesher's record, if this grid came from `abgs_grid_remesh`.
-    pub(crate) fn remeshed(&self) -> Option<&RemeshInfo> {
-        self.remeshed.as_ref()
-    }
-}
-
-/// Counts, validation findings and extent of a grid.
+/// Counts, validation findings and extent of a grid (`abgs_grid_get_stats`).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
 pub struct abgs_grid_stats {
+    /// `sizeof(abgs_grid_stats)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Vertices.
     pub vertices: u64,
     /// Triangles.
@@ -127,6 +49,15 @@ pub struct abgs_grid_stats {
     /// Heap bytes held by the grid and its BVH.
     pub memory_bytes: u64,
 }
+
+versioned!(
+    abgs_grid_stats,
+    184,
+    abgs_grid_stats {
+        struct_size: super::versioned::own_size::<abgs_grid_stats>(),
+        ..Default::default()
+    }
+);
 
 /// Builds a grid from caller arrays, which are copied (the caller keeps ownership).
 ///
@@ -283,8 +214,8 @@ pub unsafe extern "C" fn abgs_grid_get_stats(
     guard("abgs_grid_get_stats", || {
         // SAFETY: a grid from this library or NULL (checked).
         let g = unsafe { req(grid, "grid")? }.read()?;
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_stats, "out_stats")? };
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_stats, "out_stats", false)? };
         let st = g.stats();
         let r = g.report();
         let b = g.bbox();
@@ -294,7 +225,8 @@ pub unsafe extern "C" fn abgs_grid_get_stats(
                     (a.min(x), b.max(x))
                 })
         });
-        *o = abgs_grid_stats {
+        let stats = abgs_grid_stats {
+            struct_size: 0,
             vertices: st.vertices as u64,
             triangles: st.triangles as u64,
             edges: st.edges as u64,
@@ -314,7 +246,8 @@ pub unsafe extern "C" fn abgs_grid_get_stats(
             diagonal: b.diagonal(),
             memory_bytes: (st.grid_bytes + st.bvh_bytes) as u64,
         };
-        Ok(())
+        // SAFETY: checked above.
+        unsafe { write_out(out_stats, &stats, "out_stats") }
     })
 }
 
@@ -429,24 +362,20 @@ pub unsafe extern "C" fn abgs_grid_copy_sizes(
 }
 
 /// Releases a grid. NULL is accepted and ignored. Returns BUSY (and frees
-/// nothing) if another call is still using the grid; as with `free`, no thread
-/// may start a call on the grid once this one has begun.
+/// nothing) while another call is using the grid; a call that starts while
+/// this one runs gets BUSY too. As with `free`, no call may start on the grid
+/// once this one has returned OK.
 ///
 /// # Safety
-/// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
-/// number of elements; a grid pointer comes from this library and is not freed.
+/// `grid` is NULL or a grid from this library that was not freed before.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_grid_free(grid: *mut abgs_grid) -> abgs_status {
     guard("abgs_grid_free", || {
         if grid.is_null() {
             return Ok(());
         }
-        // SAFETY: non-NULL grids come from Box::into_raw in this library.
-        let h = unsafe { &*grid };
-        drop(h.write()?);
-        // SAFETY: no other call holds the lock (checked just above); ownership returns to Rust.
-        drop(unsafe { Box::from_raw(grid) });
-        Ok(())
+        // SAFETY: a live grid from this library by the caller's contract.
+        unsafe { abgs_grid::destroy(grid) }
     })
 }
 

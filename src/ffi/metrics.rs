@@ -4,12 +4,15 @@
 
 use super::boundary::*;
 use super::grid::abgs_grid;
+use super::versioned::{check_out, own_size, read_required, versioned, write_out};
 use crate::metrics::{self, AngleStats, EvalParams};
 
 /// Parameters of `abgs_evaluate`; get the defaults from `abgs_eval_params_default`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
 pub struct abgs_eval_params {
+    /// `sizeof(abgs_eval_params)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Points sampled uniformly on the reference for the size deviation, > 0
     /// (default 100 000).
     pub samples: u64,
@@ -43,6 +46,8 @@ pub struct abgs_angle_stats {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct abgs_evaluation {
+    /// `sizeof(abgs_evaluation)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Faces of the reference.
     pub faces_reference: u64,
     /// Faces of the candidate.
@@ -83,6 +88,27 @@ pub struct abgs_evaluation {
     pub seconds: f64,
 }
 
+versioned!(abgs_eval_params, 32, default_params());
+versioned!(
+    abgs_evaluation,
+    232,
+    abgs_evaluation {
+        struct_size: own_size::<abgs_evaluation>(),
+        ..Default::default()
+    }
+);
+
+/// The library's defaults as a C struct.
+fn default_params() -> abgs_eval_params {
+    let d = EvalParams::default();
+    abgs_eval_params {
+        struct_size: own_size::<abgs_eval_params>(),
+        samples: d.samples as u64,
+        hausdorff_samples: d.hausdorff_samples as u64,
+        seed: d.seed,
+    }
+}
+
 impl From<AngleStats> for abgs_angle_stats {
     fn from(a: AngleStats) -> Self {
         abgs_angle_stats {
@@ -112,24 +138,20 @@ fn count(n: u64, what: &str) -> FfiResult<usize> {
 }
 
 /// Writes the default parameters into `*out_params` (100 000 samples for the
-/// size deviation and for each side of the Hausdorff distance, seed 1).
+/// size deviation and for each side of the Hausdorff distance, seed 1); the
+/// caller has set its `struct_size` (`abgs_eval_params p = {sizeof p};`).
 ///
 /// # Safety
-/// `out_params` is NULL (reported) or writable.
+/// `out_params` is NULL (reported) or holds `struct_size` writable bytes.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_eval_params_default(
     out_params: *mut abgs_eval_params,
 ) -> abgs_status {
     guard("abgs_eval_params_default", || {
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_params, "out_params")? };
-        let d = EvalParams::default();
-        *o = abgs_eval_params {
-            samples: d.samples as u64,
-            hausdorff_samples: d.hausdorff_samples as u64,
-            seed: d.seed,
-        };
-        Ok(())
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_params, "out_params", false)? };
+        // SAFETY: as above.
+        unsafe { write_out(out_params, &default_params(), "out_params") }
     })
 }
 
@@ -160,17 +182,18 @@ pub unsafe extern "C" fn abgs_evaluate(
         let r = unsafe { req(reference, "reference")? }.read()?;
         // SAFETY: as above.
         let c = unsafe { req(candidate, "candidate")? }.read()?;
-        // SAFETY: readable or NULL (checked).
-        let p = unsafe { req(params, "params")? };
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_evaluation, "out_evaluation")? };
+        // SAFETY: NULL (reported) or `struct_size` readable bytes.
+        let p = unsafe { read_required(params, "params")? };
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_evaluation, "out_evaluation", false)? };
         let ep = EvalParams {
             samples: count(p.samples, "samples")?,
             hausdorff_samples: count(p.hausdorff_samples, "hausdorff_samples")?,
             seed: p.seed,
         };
         let e = metrics::evaluate(&r, &c, &ep)?;
-        *o = abgs_evaluation {
+        let ev = abgs_evaluation {
+            struct_size: 0,
             faces_reference: e.faces_reference as u64,
             faces_candidate: e.faces_candidate as u64,
             vertices_reference: e.vertices_reference as u64,
@@ -190,7 +213,8 @@ pub unsafe extern "C" fn abgs_evaluate(
             angles_candidate: e.angles_candidate.into(),
             seconds: e.seconds,
         };
-        Ok(())
+        // SAFETY: checked above.
+        unsafe { write_out(out_evaluation, &ev, "out_evaluation") }
     })
 }
 

@@ -8,18 +8,23 @@
 //!   NULL pointer is an error, never a crash;
 //! - a grid is an opaque [`abgs_grid`]; const calls (queries, accessors) are
 //!   thread-safe; a mutating call on a grid in use by another thread returns
-//!   [`abgs_status::ABGS_ERR_BUSY`] instead of racing.
+//!   [`abgs_status::ABGS_ERR_BUSY`] instead of racing;
+//! - nothing from C is trusted to be a valid Rust value: enumerations cross as
+//!   `uint32_t` with constants and are checked; every struct begins with
+//!   `struct_size` and grows by the one rule of [`versioned`].
 //!
 //! This is the only module with `unsafe` code.
 #![allow(non_camel_case_types)]
 
 mod boundary;
 mod grid;
+mod handle;
 mod metrics;
 mod query;
 mod remesh;
 mod simplify;
 mod sizing;
+pub(crate) mod versioned;
 
 pub use boundary::*;
 pub use grid::*;
@@ -28,3 +33,39 @@ pub use query::*;
 pub use remesh::*;
 pub use simplify::*;
 pub use sizing::*;
+pub use versioned::ABGS_MAX_STRUCT_SIZE;
+
+#[cfg(test)]
+mod tests {
+    use super::versioned::{own_size, Versioned};
+    use super::*;
+
+    fn check<T: Versioned>() {
+        let n = std::mem::size_of::<T>();
+        assert!(n <= ABGS_MAX_STRUCT_SIZE as usize, "{}", T::NAME);
+        // Until a struct grows, its first released size is its size; after,
+        // FIRST_SIZE stays and the struct only gets longer.
+        assert_eq!(T::FIRST_SIZE, n, "{}: FIRST_SIZE", T::NAME);
+        let v = T::initial();
+        // SAFETY: struct_size is the first field of every Versioned type.
+        let s = unsafe { std::ptr::read(&v as *const T as *const u32) };
+        assert_eq!(s, own_size::<T>(), "{}: initial struct_size", T::NAME);
+    }
+
+    /// Every struct that crosses the ABI follows the growth rule.
+    #[test]
+    fn every_struct_follows_the_rule() {
+        check::<abgs_grid_stats>();
+        check::<abgs_eval_params>();
+        check::<abgs_evaluation>();
+        check::<abgs_hit>();
+        check::<abgs_remesh_params>();
+        check::<abgs_remesh_report>();
+        check::<abgs_iteration_record>();
+        check::<abgs_simplify_params>();
+        check::<abgs_simplify_report>();
+        check::<abgs_size_source>();
+        check::<abgs_size_params>();
+        check::<abgs_size_report>();
+    }
+}

@@ -2,11 +2,14 @@
 
 use super::boundary::*;
 use super::grid::abgs_grid;
+use super::versioned::{check_out, own_size, versioned, write_out};
 
 /// Answer of `abgs_query_closest`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
 pub struct abgs_hit {
+    /// `sizeof(abgs_hit)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Triangle holding the closest point.
     pub triangle: u32,
     /// Barycentric coordinates on that triangle.
@@ -18,6 +21,15 @@ pub struct abgs_hit {
     /// Interpolated size (NaN when the grid has no sizes).
     pub size: f64,
 }
+
+versioned!(
+    abgs_hit,
+    72,
+    abgs_hit {
+        struct_size: own_size::<abgs_hit>(),
+        ..Default::default()
+    }
+);
 
 /// Size at `point` (3 doubles): exact closest point on the grid, barycentric
 /// interpolation there. Expected O(log F).
@@ -64,6 +76,10 @@ pub unsafe extern "C" fn abgs_query_size_hinted(
         let g = unsafe { req(grid, "grid")? }.read()?;
         // SAFETY: three doubles or NULL (checked).
         let p = unsafe { point3(point, "point")? };
+        disjoint(&[
+            (hint as *const u8, 4, "hint"),
+            (out_size as *const u8, 8, "out_size"),
+        ])?;
         // SAFETY: writable or NULL (checked).
         let h = unsafe { out(hint, "hint")? };
         // SAFETY: writable or NULL (checked).
@@ -174,17 +190,19 @@ pub unsafe extern "C" fn abgs_query_closest(
         let g = unsafe { req(grid, "grid")? }.read()?;
         // SAFETY: three doubles or NULL (checked).
         let p = unsafe { point3(point, "point")? };
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_hit, "out_hit")? };
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_hit, "out_hit", false)? };
         let h = g.closest(p, (hint != ABGS_NO_HINT).then_some(hint))?;
-        *o = abgs_hit {
+        let hit = abgs_hit {
+            struct_size: 0,
             triangle: h.triangle,
             bary: h.bary,
             point: h.point,
             distance: h.distance,
             size: h.size,
         };
-        Ok(())
+        // SAFETY: checked above.
+        unsafe { write_out(out_hit, &hit, "out_hit") }
     })
 }
 
@@ -200,6 +218,10 @@ unsafe fn batch_args<'a>(
     if n > 0 && (points.is_null() || out_sizes.is_null()) {
         return err(abgs_status::ABGS_ERR_NULL, "points or out_sizes is NULL");
     }
+    disjoint(&[
+        (points as *const u8, n.saturating_mul(24), "points"),
+        (out_sizes as *const u8, n.saturating_mul(8), "out_sizes"),
+    ])?;
     // SAFETY: [f64; 3] has the layout and alignment of three doubles; n points by contract.
     let p = unsafe { slice(points as *const [f64; 3], n, "points")? };
     // SAFETY: n writable doubles by contract.

@@ -4,6 +4,8 @@
 
 use super::boundary::*;
 use super::grid::{abgs_grid, checked_out};
+use super::handle::Held;
+use super::versioned::{check_out, own_size, read_in, versioned, write_out};
 use crate::remesh::{self, RemeshParams, TargetLength};
 use std::ffi::c_char;
 
@@ -13,6 +15,8 @@ use std::ffi::c_char;
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct abgs_remesh_params {
+    /// `sizeof(abgs_remesh_params)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Uniform target edge length L0 in model units, >= 0; 0 = use
     /// `relative_length` (default 0). Ignored in size-driven mode.
     pub edge_length: f64,
@@ -36,6 +40,8 @@ pub struct abgs_remesh_params {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
 pub struct abgs_remesh_report {
+    /// `sizeof(abgs_remesh_report)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Vertices of the input.
     pub vertices_in: u64,
     /// Triangles of the input.
@@ -67,39 +73,57 @@ pub struct abgs_remesh_report {
     pub n_issues: u64,
 }
 
-/// What the remesher kept and reported, held in the new grid's handle.
+versioned!(abgs_remesh_params, 48, default_params());
+versioned!(
+    abgs_remesh_report,
+    120,
+    abgs_remesh_report {
+        struct_size: own_size::<abgs_remesh_report>(),
+        ..Default::default()
+    }
+);
+
+/// What the remesher kept and reported, held in the new grid's handle (its
+/// provenance).
 #[derive(Debug, Clone, Default)]
-pub(crate) struct RemeshInfo {
+struct RemeshInfo {
     /// Kept feature edges, vertex pairs of the grid.
     pub feature_edges: Vec<[u32; 2]>,
     /// Texts of what could not be remeshed.
     pub issues: Vec<String>,
 }
 
-/// Writes the default parameters into `*out_params`.
+/// The library's defaults as a C struct.
+fn default_params() -> abgs_remesh_params {
+    let d = RemeshParams::default();
+    abgs_remesh_params {
+        struct_size: own_size::<abgs_remesh_params>(),
+        edge_length: 0.0,
+        relative_length: match d.target {
+            TargetLength::Relative(r) => r,
+            TargetLength::Absolute(_) => 0.01,
+        },
+        feature_angle_deg: d.feature_angle_deg,
+        iterations: d.iterations as u32,
+        curvature_limit: d.curvature_limit as i32,
+        n_circle: d.n_circle,
+    }
+}
+
+/// Writes the default parameters into `*out_params`, whose `struct_size` the
+/// caller has set (`abgs_remesh_params p = {sizeof p};`).
 ///
 /// # Safety
-/// `out_params` is NULL (reported) or writable.
+/// `out_params` is NULL (reported) or holds `struct_size` writable bytes.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_remesh_params_default(
     out_params: *mut abgs_remesh_params,
 ) -> abgs_status {
     guard("abgs_remesh_params_default", || {
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_params, "out_params")? };
-        let d = RemeshParams::default();
-        *o = abgs_remesh_params {
-            edge_length: 0.0,
-            relative_length: match d.target {
-                TargetLength::Relative(r) => r,
-                TargetLength::Absolute(_) => 0.01,
-            },
-            feature_angle_deg: d.feature_angle_deg,
-            iterations: d.iterations as u32,
-            curvature_limit: d.curvature_limit as i32,
-            n_circle: d.n_circle,
-        };
-        Ok(())
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_params, "out_params", false)? };
+        // SAFETY: as above.
+        unsafe { write_out(out_params, &default_params(), "out_params") }
     })
 }
 
@@ -202,11 +226,13 @@ pub unsafe extern "C" fn abgs_grid_remesh(
         *o = std::ptr::null_mut();
         // SAFETY: a grid from this library or NULL (checked).
         let h = unsafe { req(input, "input")? };
-        // SAFETY: readable or NULL (NULL = defaults).
-        let params = match unsafe { params.as_ref() } {
-            Some(p) => to_params(p)?,
+        // SAFETY: NULL (defaults) or `struct_size` readable bytes.
+        let params = match unsafe { read_in(params, "params")? } {
+            Some(p) => to_params(&p)?,
             None => RemeshParams::default(),
         };
+        // SAFETY: NULL (skipped) or `struct_size` writable bytes.
+        unsafe { check_out(out_report, "out_report", true)? };
         let g = h.read()?;
         let r = if sizing.is_null() {
             remesh::remesh(&g, &params)?
@@ -230,15 +256,13 @@ pub unsafe extern "C" fn abgs_grid_remesh(
             }
             remesh::remesh_sized(&g, &s, &params)?
         };
-        // SAFETY: NULL or writable.
-        if let Some(rep) = unsafe { out_report.as_mut() } {
-            *rep = report(&r);
-        }
+        // SAFETY: checked above.
+        unsafe { write_out(out_report, &report(&r), "out_report")? };
         let info = RemeshInfo {
             feature_edges: r.feature_edges,
             issues: r.report.issues,
         };
-        *o = abgs_grid::boxed_with(r.grid, Some(info));
+        *o = abgs_grid::boxed_with(r.grid, info);
         Ok(())
     })
 }
@@ -247,6 +271,7 @@ pub unsafe extern "C" fn abgs_grid_remesh(
 fn report(r: &remesh::Remeshed) -> abgs_remesh_report {
     let p = &r.report;
     abgs_remesh_report {
+        struct_size: 0,
         vertices_in: p.vertices_in as u64,
         faces_in: p.faces_in as u64,
         vertices_out: p.vertices_out as u64,
@@ -264,11 +289,10 @@ fn report(r: &remesh::Remeshed) -> abgs_remesh_report {
     }
 }
 
-/// The remesher's record of a grid made by `abgs_grid_remesh`; the caller
-/// holds the grid's read guard while using it (so that a concurrent
-/// `abgs_grid_free` returns BUSY).
-fn info(h: &abgs_grid) -> FfiResult<&RemeshInfo> {
-    h.remeshed().ok_or_else(|| {
+/// The remesher's record of a grid made by `abgs_grid_remesh`, read under
+/// the grid's lock (so that a concurrent `abgs_grid_free` returns BUSY).
+fn info(h: &Held) -> FfiResult<&RemeshInfo> {
+    h.provenance::<RemeshInfo>().ok_or_else(|| {
         FfiError(
             abgs_status::ABGS_ERR_INVALID_ARGUMENT,
             "the grid was not made by abgs_grid_remesh".into(),
@@ -290,11 +314,10 @@ pub unsafe extern "C" fn abgs_grid_remesh_feature_edge_count(
 ) -> abgs_status {
     guard("abgs_grid_remesh_feature_edge_count", || {
         // SAFETY: a grid from this library or NULL (checked).
-        let h = unsafe { req(grid, "grid")? };
-        let _g = h.read()?;
+        let g = unsafe { req(grid, "grid")? }.read()?;
         // SAFETY: writable or NULL (checked).
         let o = unsafe { out(out_count, "out_count")? };
-        *o = info(h)?.feature_edges.len();
+        *o = info(&g)?.feature_edges.len();
         Ok(())
     })
 }
@@ -313,9 +336,8 @@ pub unsafe extern "C" fn abgs_grid_remesh_copy_feature_edges(
 ) -> abgs_status {
     guard("abgs_grid_remesh_copy_feature_edges", || {
         // SAFETY: a grid from this library or NULL (checked).
-        let h = unsafe { req(grid, "grid")? };
-        let _g = h.read()?;
-        let flat = info(h)?.feature_edges.as_flattened();
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        let flat = info(&g)?.feature_edges.as_flattened();
         // SAFETY: the caller guarantees `capacity` writable indices (or NULL, reported).
         unsafe { checked_out(out_edges, capacity, flat.len(), "out_edges")? }.copy_from_slice(flat);
         Ok(())
@@ -342,9 +364,8 @@ pub unsafe extern "C" fn abgs_grid_remesh_issue(
 ) -> abgs_status {
     guard("abgs_grid_remesh_issue", || {
         // SAFETY: a grid from this library or NULL (checked).
-        let h = unsafe { req(grid, "grid")? };
-        let _g = h.read()?;
-        let issues = &info(h)?.issues;
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        let issues = &info(&g)?.issues;
         let text = issues.get(index).ok_or_else(|| {
             FfiError(
                 abgs_status::ABGS_ERR_OUT_OF_RANGE,

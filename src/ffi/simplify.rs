@@ -4,36 +4,33 @@
 
 use super::boundary::*;
 use super::grid::{abgs_grid, checked_out};
+use super::versioned::{check_out, own_size, read_in, versioned, write_out};
 use crate::simplify::{self, IterationRecord, SimplifyParams, StopReason};
 use std::ffi::c_void;
 
-/// Simplification method.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum abgs_method {
-    /// LBO-ABGS, the procedural simplifier (accurate estimation of every candidate).
-    ABGS_METHOD_LBO = 0,
-    /// GCN-ABGS, the learned simplifier: not in this build (ABGS_ERR_NOT_AVAILABLE).
-    ABGS_METHOD_GCN = 1,
-}
+/// Method (`abgs_simplify_params.method`): LBO-ABGS, the procedural
+/// simplifier (accurate estimation of every candidate).
+pub const ABGS_METHOD_LBO: u32 = 0;
+/// Method: GCN-ABGS, the learned simplifier: not in this build
+/// (ABGS_ERR_NOT_AVAILABLE).
+pub const ABGS_METHOD_GCN: u32 = 1;
 
-/// Why a simplification stopped.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum abgs_stop {
-    /// Nothing could be selected any more.
-    ABGS_STOP_CONVERGED = 0,
-    /// `max_iterations` reached.
-    ABGS_STOP_MAX_ITERATIONS = 1,
-    /// The progress callback asked to stop; the grid is valid.
-    ABGS_STOP_CANCELLED = 2,
-}
+/// Why a simplification stopped (`abgs_simplify_report.stop`): nothing could
+/// be selected any more.
+pub const ABGS_STOP_CONVERGED: u32 = 0;
+/// Stop: `max_iterations` reached.
+pub const ABGS_STOP_MAX_ITERATIONS: u32 = 1;
+/// Stop: the progress callback asked to stop; the grid is valid.
+pub const ABGS_STOP_CANCELLED: u32 = 2;
 
 /// What one iteration did (given to the progress callback, and readable
-/// afterwards with `abgs_grid_simplify_iteration`).
+/// afterwards with `abgs_grid_simplify_iteration`). In the callback,
+/// `struct_size` is the library's size: read a field only if it lies below it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct abgs_iteration_record {
+    /// `sizeof(abgs_iteration_record)` (the header's growth rule).
+    pub struct_size: u32,
     /// Iteration number, from 1.
     pub iteration: u64,
     /// Faces after the iteration.
@@ -58,6 +55,15 @@ pub struct abgs_iteration_record {
     pub seconds: f64,
 }
 
+versioned!(
+    abgs_iteration_record,
+    96,
+    abgs_iteration_record {
+        struct_size: own_size::<abgs_iteration_record>(),
+        ..Default::default()
+    }
+);
+
 /// Called after every iteration that collapsed something, with its record and `user_data`; return 0 to
 /// go on, anything else to stop (the grid made so far is returned, valid).
 pub type abgs_progress_fn = Option<
@@ -70,8 +76,11 @@ pub type abgs_progress_fn = Option<
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct abgs_simplify_params {
-    /// ABGS_METHOD_LBO (default) or ABGS_METHOD_GCN.
-    pub method: abgs_method,
+    /// `sizeof(abgs_simplify_params)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
+    /// ABGS_METHOD_LBO (default) or ABGS_METHOD_GCN; other values are
+    /// ABGS_ERR_INVALID_ARGUMENT.
+    pub method: u32,
     /// Largest share of the edges collapsed per iteration, in (0, 1] (default 0.10).
     pub fraction: f64,
     /// Candidate pool as a multiple of `fraction`·|E|, >= 1 (default 2).
@@ -102,8 +111,10 @@ pub struct abgs_simplify_params {
 
 /// What `abgs_simplify` did.
 #[repr(C)]
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct abgs_simplify_report {
+    /// `sizeof(abgs_simplify_report)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Faces of the dense grid.
     pub faces_in: u64,
     /// Vertices of the dense grid.
@@ -114,8 +125,9 @@ pub struct abgs_simplify_report {
     pub vertices_out: u64,
     /// Iterations run (records: `abgs_grid_simplify_iteration`).
     pub iterations: u64,
-    /// Why it stopped.
-    pub stop: abgs_stop,
+    /// Why it stopped: ABGS_STOP_CONVERGED, ABGS_STOP_MAX_ITERATIONS or
+    /// ABGS_STOP_CANCELLED.
+    pub stop: u32,
     /// Feature lines of the dense grid.
     pub feature_lines: u64,
     /// Corners (never moved).
@@ -128,40 +140,69 @@ pub struct abgs_simplify_report {
     pub seconds: f64,
 }
 
-/// Writes the default parameters into `*out_params`.
+versioned!(abgs_simplify_params, 112, default_params());
+versioned!(
+    abgs_simplify_report,
+    96,
+    abgs_simplify_report {
+        struct_size: own_size::<abgs_simplify_report>(),
+        ..Default::default()
+    }
+);
+
+/// The library's defaults as a C struct.
+fn default_params() -> abgs_simplify_params {
+    let d = SimplifyParams::default();
+    abgs_simplify_params {
+        struct_size: own_size::<abgs_simplify_params>(),
+        method: ABGS_METHOD_LBO,
+        fraction: d.fraction,
+        pool_factor: d.pool_factor,
+        t_size: d.t_size,
+        tau_d: d.tau_d,
+        max_distance: 0.0,
+        max_iterations: d.max_iterations as u32,
+        feature_angle_deg: d.feature_angle_deg,
+        corner_angle_deg: d.corner_angle_deg,
+        max_normal_turn_deg: d.max_normal_turn_deg,
+        max_angle_deg: d.max_angle_deg,
+        repair: 1,
+        progress: None,
+        user_data: std::ptr::null_mut(),
+    }
+}
+
+/// The per-iteration records a simplified grid's handle keeps (its provenance).
+struct SimplifyRecords(Vec<abgs_iteration_record>);
+
+/// Writes the default parameters into `*out_params`, whose `struct_size` the
+/// caller has set (`abgs_simplify_params p = {sizeof p};`).
 ///
 /// # Safety
-/// `out_params` is NULL (reported) or writable.
+/// `out_params` is NULL (reported) or holds `struct_size` writable bytes.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_simplify_params_default(
     out_params: *mut abgs_simplify_params,
 ) -> abgs_status {
     guard("abgs_simplify_params_default", || {
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_params, "out_params")? };
-        let d = SimplifyParams::default();
-        *o = abgs_simplify_params {
-            method: abgs_method::ABGS_METHOD_LBO,
-            fraction: d.fraction,
-            pool_factor: d.pool_factor,
-            t_size: d.t_size,
-            tau_d: d.tau_d,
-            max_distance: 0.0,
-            max_iterations: d.max_iterations as u32,
-            feature_angle_deg: d.feature_angle_deg,
-            corner_angle_deg: d.corner_angle_deg,
-            max_normal_turn_deg: d.max_normal_turn_deg,
-            max_angle_deg: d.max_angle_deg,
-            repair: 1,
-            progress: None,
-            user_data: std::ptr::null_mut(),
-        };
-        Ok(())
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_params, "out_params", false)? };
+        // SAFETY: as above.
+        unsafe { write_out(out_params, &default_params(), "out_params") }
     })
 }
 
 /// Converts C parameters to Rust ones.
 fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
+    if p.method != ABGS_METHOD_LBO && p.method != ABGS_METHOD_GCN {
+        return err(
+            abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+            format!(
+                "method = {} is none of ABGS_METHOD_LBO (0), ABGS_METHOD_GCN (1)",
+                p.method
+            ),
+        );
+    }
     for (x, what) in [
         (p.fraction, "fraction"),
         (p.pool_factor, "pool_factor"),
@@ -214,6 +255,7 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
 
 fn record(r: &IterationRecord) -> abgs_iteration_record {
     abgs_iteration_record {
+        struct_size: own_size::<abgs_iteration_record>(),
         iteration: r.iteration as u64,
         faces: r.faces as u64,
         vertices: r.vertices as u64,
@@ -262,25 +304,18 @@ pub unsafe extern "C" fn abgs_simplify(
         *o = std::ptr::null_mut();
         // SAFETY: a grid from this library or NULL (checked).
         let h = unsafe { req(grid, "grid")? };
-        let mut defaults = None;
-        // SAFETY: readable or NULL (NULL = defaults).
-        let p = match unsafe { params.as_ref() } {
-            Some(p) => p,
-            None => {
-                let mut d = std::mem::MaybeUninit::<abgs_simplify_params>::uninit();
-                // SAFETY: a valid out-pointer to our own local.
-                unsafe { abgs_simplify_params_default(d.as_mut_ptr()) };
-                // SAFETY: just initialised by the call above.
-                defaults.insert(unsafe { d.assume_init() })
-            }
-        };
-        if p.method == abgs_method::ABGS_METHOD_GCN {
+        // SAFETY: NULL (defaults) or `struct_size` readable bytes.
+        let p = unsafe { read_in(params, "params")? }.unwrap_or_else(default_params);
+        // SAFETY: NULL (skipped) or `struct_size` writable bytes; checked
+        // before the work so that a bad struct_size fails fast.
+        unsafe { check_out(out_report, "out_report", true)? };
+        let rp = to_params(&p)?;
+        if p.method == ABGS_METHOD_GCN {
             return err(
                 abgs_status::ABGS_ERR_NOT_AVAILABLE,
                 "the learned simplifier (GCN-ABGS) is not available in this build; use ABGS_METHOD_LBO",
             );
         }
-        let rp = to_params(p)?;
         let g = h.read()?;
         if g.sizes().is_none() {
             return err(abgs_status::ABGS_ERR_NO_SIZES, "the grid has no sizes");
@@ -297,31 +332,31 @@ pub unsafe extern "C" fn abgs_simplify(
         };
         let s = simplify::simplify(&g, &rp, Some(&mut call))?;
         let r = &s.report;
-        // SAFETY: NULL or writable.
-        if let Some(rep) = unsafe { out_report.as_mut() } {
-            *rep = abgs_simplify_report {
-                faces_in: r.faces_in as u64,
-                vertices_in: r.vertices_in as u64,
-                faces_out: r.faces_out as u64,
-                vertices_out: r.vertices_out as u64,
-                iterations: r.iterations.len() as u64,
-                stop: match r.stop {
-                    StopReason::Converged => abgs_stop::ABGS_STOP_CONVERGED,
-                    StopReason::MaxIterations => abgs_stop::ABGS_STOP_MAX_ITERATIONS,
-                    StopReason::Cancelled => abgs_stop::ABGS_STOP_CANCELLED,
-                },
-                feature_lines: r.feature_lines as u64,
-                corners: r.corners as u64,
-                element_count_in: r.element_count_in,
-                element_count_out: r
-                    .iterations
-                    .last()
-                    .map_or(r.element_count_in, |i| i.element_count),
-                seconds: r.seconds,
-            };
-        }
-        let records = r.iterations.iter().map(record).collect();
-        *o = abgs_grid::boxed_simplified(s.grid, records);
+        let report = abgs_simplify_report {
+            struct_size: 0,
+            faces_in: r.faces_in as u64,
+            vertices_in: r.vertices_in as u64,
+            faces_out: r.faces_out as u64,
+            vertices_out: r.vertices_out as u64,
+            iterations: r.iterations.len() as u64,
+            stop: match r.stop {
+                StopReason::Converged => ABGS_STOP_CONVERGED,
+                StopReason::MaxIterations => ABGS_STOP_MAX_ITERATIONS,
+                StopReason::Cancelled => ABGS_STOP_CANCELLED,
+            },
+            feature_lines: r.feature_lines as u64,
+            corners: r.corners as u64,
+            element_count_in: r.element_count_in,
+            element_count_out: r
+                .iterations
+                .last()
+                .map_or(r.element_count_in, |i| i.element_count),
+            seconds: r.seconds,
+        };
+        // SAFETY: checked above.
+        unsafe { write_out(out_report, &report, "out_report")? };
+        let records = SimplifyRecords(r.iterations.iter().map(record).collect());
+        *o = abgs_grid::boxed_with(s.grid, records);
         Ok(())
     })
 }
@@ -341,18 +376,18 @@ pub unsafe extern "C" fn abgs_grid_simplify_iteration(
 ) -> abgs_status {
     guard("abgs_grid_simplify_iteration", || {
         // SAFETY: a grid from this library or NULL (checked).
-        let h = unsafe { req(grid, "grid")? };
-        let _g = h.read()?;
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_record, "out_record")? };
-        let recs = h.iterations();
-        *o = *recs.get(index).ok_or_else(|| {
+        let g = unsafe { req(grid, "grid")? }.read()?;
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_record, "out_record", false)? };
+        let recs = g.provenance::<SimplifyRecords>().map_or(&[][..], |r| &r.0);
+        let rec = recs.get(index).ok_or_else(|| {
             FfiError(
                 abgs_status::ABGS_ERR_OUT_OF_RANGE,
                 format!("iteration {index} of {}", recs.len()),
             )
         })?;
-        Ok(())
+        // SAFETY: checked above.
+        unsafe { write_out(out_record, rec, "out_record") }
     })
 }
 
@@ -382,9 +417,9 @@ pub unsafe extern "C" fn abgs_edge_scores(
     guard("abgs_edge_scores", || {
         // SAFETY: a grid from this library or NULL (checked).
         let h = unsafe { req(grid, "grid")? };
-        // SAFETY: readable or NULL (NULL = defaults).
-        let rp = match unsafe { params.as_ref() } {
-            Some(p) => to_params(p)?,
+        // SAFETY: NULL (defaults) or `struct_size` readable bytes.
+        let rp = match unsafe { read_in(params, "params")? } {
+            Some(p) => to_params(&p)?,
             None => SimplifyParams::default(),
         };
         let g = h.read()?;
@@ -398,6 +433,13 @@ pub unsafe extern "C" fn abgs_edge_scores(
                 format!("capacity {capacity} < {n} edges"),
             );
         }
+        let b = n.saturating_mul(8);
+        disjoint(&[
+            (out_ds as *const u8, b, "out_ds"),
+            (out_dd as *const u8, b, "out_dd"),
+            (out_valid as *const u8, n, "out_valid"),
+            (out_y as *const u8, b, "out_y"),
+        ])?;
         let scores = simplify::edge_scores(&g, &rp)?;
         macro_rules! fill {
             ($ptr:expr, $name:expr, $f:expr) => {

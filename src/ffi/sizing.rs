@@ -3,6 +3,7 @@
 
 use super::boundary::*;
 use super::grid::{abgs_grid, checked_out};
+use super::versioned::{check_out, own_size, read_array, read_required, versioned, write_out};
 use crate::sizing::{Gradation, SizeParams, SizeSource, SourceShape};
 
 /// Source kind: a point (`points[0..3]`).
@@ -12,10 +13,13 @@ pub const ABGS_SOURCE_SEGMENT: u32 = 1;
 /// Source kind: a triangle (`points[0..9]`).
 pub const ABGS_SOURCE_TRIANGLE: u32 = 2;
 
-/// A user size source: every vertex within `radius` of the shape gets at most `size`.
+/// A user size source: every vertex within `radius` of the shape gets at most
+/// `size`. In an array, every element states the same `struct_size`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
 pub struct abgs_size_source {
+    /// `sizeof(abgs_size_source)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// `ABGS_SOURCE_POINT`, `ABGS_SOURCE_SEGMENT` or `ABGS_SOURCE_TRIANGLE`.
     pub kind: u32,
     /// Up to three points, x y z each (unused entries ignored).
@@ -30,6 +34,8 @@ pub struct abgs_size_source {
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 pub struct abgs_size_params {
+    /// `sizeof(abgs_size_params)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Elements per full circle for curvature sizes (default 24).
     pub n_circle: f64,
     /// Elements across a gap or wall (default 3).
@@ -64,6 +70,8 @@ pub struct abgs_size_params {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default)]
 pub struct abgs_size_report {
+    /// `sizeof(abgs_size_report)`, set by the caller (the header's growth rule).
+    pub struct_size: u32,
     /// Smallest size used.
     pub hmin: f64,
     /// Largest size used.
@@ -104,35 +112,60 @@ pub struct abgs_size_report {
     pub seconds_contacts: f64,
 }
 
-/// Writes the default parameters into `*out_params`.
+versioned!(
+    abgs_size_source,
+    96,
+    abgs_size_source {
+        struct_size: own_size::<abgs_size_source>(),
+        ..Default::default()
+    }
+);
+versioned!(abgs_size_params, 112, default_params());
+versioned!(
+    abgs_size_report,
+    160,
+    abgs_size_report {
+        struct_size: own_size::<abgs_size_report>(),
+        ..Default::default()
+    }
+);
+
+/// The library's defaults as a C struct.
+fn default_params() -> abgs_size_params {
+    let d = SizeParams::default();
+    abgs_size_params {
+        struct_size: own_size::<abgs_size_params>(),
+        n_circle: d.n_circle,
+        n_gap: d.n_gap,
+        hmin: 0.0,
+        hmax: 0.0,
+        feature_angle_deg: d.feature_angle_deg,
+        feature_size: 0.0,
+        beta: 1.2,
+        slope: 0.0,
+        curvature: 1,
+        proximity: 1,
+        gradation: 1,
+        contact_gap: 0.0,
+        sources: std::ptr::null(),
+        n_sources: 0,
+    }
+}
+
+/// Writes the default parameters into `*out_params`, whose `struct_size` the
+/// caller has set (`abgs_size_params p = {sizeof p};`).
 ///
 /// # Safety
-/// `out_params` is NULL (reported) or writable.
+/// `out_params` is NULL (reported) or holds `struct_size` writable bytes.
 #[no_mangle]
 pub unsafe extern "C" fn abgs_size_params_default(
     out_params: *mut abgs_size_params,
 ) -> abgs_status {
     guard("abgs_size_params_default", || {
-        // SAFETY: writable or NULL (checked).
-        let o = unsafe { out(out_params, "out_params")? };
-        let d = SizeParams::default();
-        *o = abgs_size_params {
-            n_circle: d.n_circle,
-            n_gap: d.n_gap,
-            hmin: 0.0,
-            hmax: 0.0,
-            feature_angle_deg: d.feature_angle_deg,
-            feature_size: 0.0,
-            beta: 1.2,
-            slope: 0.0,
-            curvature: 1,
-            proximity: 1,
-            gradation: 1,
-            contact_gap: 0.0,
-            sources: std::ptr::null(),
-            n_sources: 0,
-        };
-        Ok(())
+        // SAFETY: NULL (reported) or `struct_size` writable bytes.
+        unsafe { check_out(out_params, "out_params", false)? };
+        // SAFETY: as above.
+        unsafe { write_out(out_params, &default_params(), "out_params") }
     })
 }
 
@@ -151,7 +184,7 @@ unsafe fn to_params(p: &abgs_size_params) -> FfiResult<SizeParams> {
         }
     };
     // SAFETY: forwarded contract on sources.
-    let src = unsafe { slice(p.sources, p.n_sources, "sources")? };
+    let src = unsafe { read_array(p.sources, p.n_sources, "sources")? };
     let mut sources = Vec::with_capacity(src.len());
     for (i, s) in src.iter().enumerate() {
         let q = |k: usize| [s.points[3 * k], s.points[3 * k + 1], s.points[3 * k + 2]];
@@ -213,38 +246,39 @@ pub unsafe extern "C" fn abgs_compute_size(
     guard("abgs_compute_size", || {
         // SAFETY: a grid from this library or NULL (checked).
         let h = unsafe { req(grid as *const abgs_grid, "grid")? };
-        // SAFETY: readable or NULL (checked).
-        let p = unsafe { req(params, "params")? };
+        // SAFETY: NULL (reported) or `struct_size` readable bytes.
+        let p = unsafe { read_required(params, "params")? };
         // SAFETY: sources contract forwarded.
-        let params = unsafe { to_params(p)? };
+        let params = unsafe { to_params(&p)? };
+        // SAFETY: NULL (skipped) or `struct_size` writable bytes.
+        unsafe { check_out(out_report, "out_report", true)? };
         let mut g = h.write()?;
         let r = g.compute_sizes(&params)?;
-        // SAFETY: NULL or writable.
-        if let Some(o) = unsafe { out_report.as_mut() } {
-            let l = r.limited_by;
-            *o = abgs_size_report {
-                hmin: r.hmin,
-                hmax: r.hmax,
-                slope: r.slope.unwrap_or(0.0),
-                feature_edges: r.feature_edges as u64,
-                patches: r.patches as u64,
-                limited_by_curvature: l.curvature as u64,
-                limited_by_proximity: l.proximity as u64,
-                limited_by_feature: l.feature as u64,
-                limited_by_source: l.source as u64,
-                clamped_to_hmin: l.hmin as u64,
-                at_hmax: l.hmax as u64,
-                faces_fixed: r.gradation.faces_fixed as u64,
-                max_slope_ratio: r.gradation.max_slope_ratio,
-                seconds_features: r.seconds_features,
-                seconds_curvature: r.seconds_curvature,
-                seconds_proximity: r.seconds_proximity,
-                seconds_gradation: r.seconds_gradation,
-                contact_vertices: r.contact_vertices as u64,
-                seconds_contacts: r.seconds_contacts,
-            };
-        }
-        Ok(())
+        let l = r.limited_by;
+        let report = abgs_size_report {
+            struct_size: 0,
+            hmin: r.hmin,
+            hmax: r.hmax,
+            slope: r.slope.unwrap_or(0.0),
+            feature_edges: r.feature_edges as u64,
+            patches: r.patches as u64,
+            limited_by_curvature: l.curvature as u64,
+            limited_by_proximity: l.proximity as u64,
+            limited_by_feature: l.feature as u64,
+            limited_by_source: l.source as u64,
+            clamped_to_hmin: l.hmin as u64,
+            at_hmax: l.hmax as u64,
+            faces_fixed: r.gradation.faces_fixed as u64,
+            max_slope_ratio: r.gradation.max_slope_ratio,
+            seconds_features: r.seconds_features,
+            seconds_curvature: r.seconds_curvature,
+            seconds_proximity: r.seconds_proximity,
+            seconds_gradation: r.seconds_gradation,
+            contact_vertices: r.contact_vertices as u64,
+            seconds_contacts: r.seconds_contacts,
+        };
+        // SAFETY: checked above.
+        unsafe { write_out(out_report, &report, "out_report") }
     })
 }
 
@@ -360,6 +394,10 @@ pub unsafe extern "C" fn abgs_lbo(
                 format!("out_edge holds {edge_capacity}, {ne} needed"),
             );
         }
+        disjoint(&[
+            (out_vertex as *const u8, nv.saturating_mul(8), "out_vertex"),
+            (out_edge as *const u8, ne.saturating_mul(8), "out_edge"),
+        ])?;
         let l = g.lbo()?;
         if !out_vertex.is_null() {
             // SAFETY: non-NULL with capacity >= nv (checked).
