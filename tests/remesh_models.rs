@@ -9,9 +9,8 @@ use abgs::remesh::{quality, remesh, remesh_sized, RemeshParams};
 use abgs::sizing::SizeParams;
 use abgs::Grid;
 
-fn load(name: &str) -> Option<Grid> {
-    let dir = common::shared_meshes()?;
-    Some(Grid::load(&dir.join(name)).unwrap())
+fn load(name: &str) -> Grid {
+    Grid::load(&common::shared_meshes().join(name)).unwrap()
 }
 
 #[test]
@@ -19,7 +18,7 @@ fn dense_grids_of_shared_models_pass_the_acceptance() {
     // One sharp-edged part, one with two bodies, one assembly of three
     // bodies with fillets.
     for name in ["netgen_hinge.stl", "occt_crankarm.stl", "abc_00000050.stl"] {
-        let Some(g) = load(name) else { return };
+        let g = load(name);
         let out = remesh(&g, &RemeshParams::default()).unwrap();
         let a = quality::evaluate(&g, &out.grid, Some(&out.feature_edges), 30.0, 30_000);
         assert!(a.failures().is_empty(), "{name}: {:?}\n{a:?}", a.failures());
@@ -30,9 +29,7 @@ fn dense_grids_of_shared_models_pass_the_acceptance() {
 
 #[test]
 fn size_driven_mode_follows_a_computed_field() {
-    let Some(mut g) = load("occt_crankarm.stl") else {
-        return;
-    };
+    let mut g = load("occt_crankarm.stl");
     g.compute_sizes(&SizeParams::default()).unwrap();
     let out = remesh_sized(&g, &g, &RemeshParams::default()).unwrap();
     let (mean, within) =

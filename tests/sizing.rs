@@ -250,9 +250,7 @@ fn pipeline_grades_and_respects_bounds() {
 
 #[test]
 fn same_bits_with_one_and_two_threads() {
-    let Some(dir) = common::shared_meshes() else {
-        return;
-    };
+    let dir = common::shared_meshes();
     let g = abgs::Grid::load(&dir.join("occt_crankarm.stl")).unwrap();
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()

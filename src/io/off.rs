@@ -331,10 +331,16 @@ pub(super) mod tests {
                 .all(|(p, q)| (0..3).all(|k| p[k].to_bits() == q[k].to_bits()))
     }
 
-    /// The shared test-mesh folder, when present.
-    pub(crate) fn shared_mesh(name: &str) -> Option<std::path::PathBuf> {
+    /// A model of the shared test-mesh folder (`../shared/meshes` beside the
+    /// checkout); a test that needs it fails when it is missing.
+    pub(crate) fn shared_mesh(name: &str) -> std::path::PathBuf {
         let p = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes/")).join(name);
-        p.is_file().then_some(p)
+        assert!(
+            p.is_file(),
+            "{} is missing: the tests need ../shared beside the checkout",
+            p.display()
+        );
+        p
     }
 
     #[test]
@@ -409,11 +415,10 @@ pub(super) mod tests {
 
     #[test]
     fn shared_fandisk() {
-        if let Some(p) = shared_mesh("cgal_fandisk.off") {
-            let d = read(&p).unwrap();
-            assert_eq!((d.vertices.len(), d.triangles.len()), (6475, 12946));
-            let n = d.vertices.len() as u32;
-            assert!(d.triangles.iter().flatten().all(|&v| v < n));
-        }
+        let p = shared_mesh("cgal_fandisk.off");
+        let d = read(&p).unwrap();
+        assert_eq!((d.vertices.len(), d.triangles.len()), (6475, 12946));
+        let n = d.vertices.len() as u32;
+        assert!(d.triangles.iter().flatten().all(|&v| v < n));
     }
 }

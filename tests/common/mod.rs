@@ -6,17 +6,16 @@ pub mod shapes;
 use std::path::PathBuf;
 
 /// The third-party models folder (`../shared/meshes` beside the checkout).
-/// Returns `None` (and says so) when it is absent outside CI; in CI it must exist.
-pub fn shared_meshes() -> Option<PathBuf> {
+/// A test that needs it fails when it is missing: a model test that passes
+/// without its model would prove nothing.
+pub fn shared_meshes() -> PathBuf {
     let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/meshes"));
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!("{} is missing: CI must provide ../shared", dir.display());
-    }
-    eprintln!("skipping: {} not found", dir.display());
-    None
+    assert!(
+        dir.is_dir(),
+        "{} is missing: the tests need ../shared beside the checkout",
+        dir.display()
+    );
+    dir
 }
 
 /// A positive linear field a·x + b·y + c·z + d over the grid's bounding box.
