@@ -72,7 +72,7 @@ pub(crate) fn check_range(x: f64, lo: f64, hi: f64, what: &str) -> Result<()> {
         Ok(())
     } else {
         Err(Error::InvalidArgument(format!(
-            "{what} = {x} must be in [{lo}, {hi}]"
+            "{what} = {x:?} must be in [{lo:?}, {hi:?}]"
         )))
     }
 }

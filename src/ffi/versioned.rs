@@ -213,7 +213,7 @@ pub(crate) unsafe fn read_array<T: Versioned>(
     }
     check_aligned(p, what)?;
     // SAFETY: the first element is readable by contract.
-    let stride = unsafe { caller_size(p, what)? };
+    let stride = unsafe { caller_size(p, &format!("{what}[0]"))? };
     if !stride.is_multiple_of(std::mem::align_of::<T>()) {
         return err(
             abgs_status::ABGS_ERR_INVALID_ARGUMENT,

@@ -68,6 +68,38 @@ pub struct Grid {
     report: ValidationReport,
 }
 
+/// Smallest and largest bounding-box diagonal a grid may have. The pipeline
+/// forms products of up to four lengths (areas squared, the quadrics of the
+/// QEM baseline, cotangent weights over areas); inside this range every such
+/// product, L⁴ ∈ [1e-300, 1e300], stays a normal f64, so a model's results do
+/// not depend on its scale. Outside it, rescale the coordinates.
+pub const EXTENT_RANGE: [f64; 2] = [1e-75, 1e75];
+
+/// Checks a model's bounding-box diagonal against [`EXTENT_RANGE`]: NonFinite
+/// when it overflows, InvalidArgument when finite but outside (a single point,
+/// extent 0, is left to the degenerate-triangle checks, which report an empty
+/// grid). The diagonal is bracketed by the largest side `m` (m ≤ d ≤ √3·m),
+/// which neither underflows nor overflows where the squared sum would.
+fn check_extent(bbox: &Aabb) -> Result<()> {
+    let [lo, hi] = EXTENT_RANGE;
+    let m = (0..3).fold(0.0f64, |m, k| m.max(bbox.max[k] - bbox.min[k]));
+    let diagonal = m * 3f64.sqrt();
+    if m == 0.0 || (m >= lo && diagonal <= hi) {
+        return Ok(());
+    }
+    let why =
+        "(rescale the coordinates) so that lengths to the fourth power stay finite and non-zero";
+    if diagonal.is_finite() {
+        Err(Error::InvalidArgument(format!(
+            "the model's bounding-box diagonal is {diagonal:e}; it must lie in [{lo:e}, {hi:e}] {why}"
+        )))
+    } else {
+        Err(Error::NonFinite(format!(
+            "the model's bounding-box diagonal overflows f64; it must lie in [{lo:e}, {hi:e}] {why}"
+        )))
+    }
+}
+
 impl Grid {
     /// Builds a grid from vertices, triangles and optional per-vertex sizes.
     ///
@@ -138,6 +170,7 @@ impl Grid {
             ..Default::default()
         };
         let bbox = Aabb::from_points(&vertices);
+        check_extent(&bbox)?;
         let mut sizes = sizes;
         if let Some(rel) = options.weld_relative_tolerance {
             if !(rel.is_finite() && rel >= 0.0) {
