@@ -112,7 +112,7 @@ fn free(g: *mut abgs_grid) {
 /// Runs `f` on the cube grid (with sizes when `sized`), then frees it.
 fn with_cube(sized: bool, f: impl FnOnce(*mut abgs_grid) -> Outcome) -> Outcome {
     let (v, t) = cube();
-    let s = vec![0.3; 8];
+    let s = [0.3; 8];
     let (o, g) = from_arrays(&v, 8, &t, 12, sized.then_some(&s[..]));
     assert_eq!(o.status, abgs_status::ABGS_OK, "{}", o.message);
     let r = f(g);
@@ -734,7 +734,7 @@ fn cases() -> Vec<(
             "",
             c(Box::new(|| {
                 with_cube(true, |g| {
-                    let s = vec![0.5; 7];
+                    let s = [0.5; 7];
                     // SAFETY: 7 doubles.
                     outcome(unsafe { abgs_grid_set_sizes(g, s.as_ptr(), 7) })
                 })
