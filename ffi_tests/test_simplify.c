@@ -140,9 +140,10 @@ int main(void) {
     CHECK_STATUS(abgs_edge_scores(NULL, NULL, NULL, NULL, NULL, y, ne), ABGS_ERR_NULL);
 
     /* Errors. */
-    CHECK_STATUS(abgs_simplify(NULL, &p, &out, NULL), ABGS_ERR_NULL);
-    CHECK_STATUS(abgs_simplify(dense, &p, NULL, NULL), ABGS_ERR_NULL);
     abgs_grid *none = NULL;
+    CHECK_STATUS(abgs_simplify(NULL, &p, &none, NULL), ABGS_ERR_NULL);
+    CHECK(none == NULL);
+    CHECK_STATUS(abgs_simplify(dense, &p, NULL, NULL), ABGS_ERR_NULL);
     abgs_simplify_params bad = p;
     bad.method = ABGS_METHOD_GCN;
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_NOT_AVAILABLE);

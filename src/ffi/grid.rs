@@ -194,9 +194,19 @@ pub unsafe extern "C" fn abgs_grid_set_sizes(
         if sizes.is_null() {
             return err(abgs_status::ABGS_ERR_NULL, "sizes is NULL");
         }
+        let mut g = h.write()?;
+        // The count is checked before anything is read, so a wrong count
+        // never makes the library read past the caller's array.
+        let nv = g.vertices().len();
+        if n != nv {
+            return err(
+                abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+                format!("{n} sizes given for {nv} vertices"),
+            );
+        }
         // SAFETY: the caller guarantees n doubles at sizes.
         let s = unsafe { slice(sizes, n, "sizes")? }.to_vec();
-        h.write()?.set_sizes(s)?;
+        g.set_sizes(s)?;
         Ok(())
     })
 }
