@@ -15,7 +15,8 @@
  *   ABGS_ERR_INVALID_ARGUMENT, never undefined behaviour.
  * - Growth: every struct begins with `uint32_t struct_size`. Set it to sizeof
  *   the struct before passing it, in or out:
- *       abgs_simplify_params sp = {sizeof sp};
+ *       abgs_simplify_params sp = {.struct_size = sizeof sp};   (C)
+ *       abgs_simplify_params sp{}; sp.struct_size = sizeof sp;  (C++)
  *       abgs_simplify_params_default(&sp);
  *   The library reads and writes at most struct_size bytes. Fields an older
  *   header lacks take their defaults; fields a newer header adds must be zero
@@ -639,7 +640,7 @@ abgs_status abgs_grid_free(abgs_grid *grid);
 
 // Writes the default parameters into `*out_params` (100 000 samples for the
 // size deviation and for each side of the Hausdorff distance, seed 1); the
-// caller has set its `struct_size` (`abgs_eval_params p = {sizeof p};`).
+// caller has set its `struct_size` (`abgs_eval_params p = {.struct_size = sizeof p};`).
 //
 // # Safety
 // `out_params` is NULL (reported) or holds `struct_size` writable bytes.
@@ -654,9 +655,8 @@ abgs_status abgs_eval_params_default(abgs_eval_params *out_params);
 // samples and m Hausdorff samples; the 7 candidate queries per reference face
 // of the element count dominate on dense references.
 //
-// `params` NULL = the defaults. Errors: NULL, INVALID_ARGUMENT (a sample
-// count of 0), NO_SIZES, INVALID_SIZE (a size met that is not finite and > 0),
-// BUSY.
+// Errors: NULL, INVALID_ARGUMENT (a sample count of 0), NO_SIZES, INVALID_SIZE
+// (a size met that is not finite and > 0), BUSY.
 //
 // # Safety
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid; grid pointers
@@ -776,7 +776,7 @@ abgs_status abgs_query_closest(const abgs_grid *grid,
                                abgs_hit *out_hit);
 
 // Writes the default parameters into `*out_params`, whose `struct_size` the
-// caller has set (`abgs_remesh_params p = {sizeof p};`).
+// caller has set (`abgs_remesh_params p = {.struct_size = sizeof p};`).
 //
 // # Safety
 // `out_params` is NULL (reported) or holds `struct_size` writable bytes.
@@ -855,7 +855,7 @@ abgs_status abgs_grid_remesh_issue(const abgs_grid *grid,
                                    size_t *out_len);
 
 // Writes the default parameters into `*out_params`, whose `struct_size` the
-// caller has set (`abgs_simplify_params p = {sizeof p};`).
+// caller has set (`abgs_simplify_params p = {.struct_size = sizeof p};`).
 //
 // # Safety
 // `out_params` is NULL (reported) or holds `struct_size` writable bytes.
@@ -920,7 +920,7 @@ abgs_status abgs_edge_scores(const abgs_grid *grid,
                              size_t capacity);
 
 // Writes the default parameters into `*out_params`, whose `struct_size` the
-// caller has set (`abgs_size_params p = {sizeof p};`).
+// caller has set (`abgs_size_params p = {.struct_size = sizeof p};`).
 //
 // # Safety
 // `out_params` is NULL (reported) or holds `struct_size` writable bytes.
@@ -928,9 +928,8 @@ abgs_status abgs_size_params_default(abgs_size_params *out_params);
 
 // Computes sizes on the grid's vertices from its geometry (curvature,
 // proximity, features, sources, clamped to [hmin, hmax], then graded) and
-// installs them; `params` NULL = the defaults; `out_report` (may be NULL)
-// receives what was done. Errors: NULL (grid), INVALID_ARGUMENT / NON_FINITE /
-// INVALID_SIZE (parameters), BUSY.
+// installs them; `out_report` (may be NULL) receives what was done.
+// Errors: NULL, INVALID_ARGUMENT / NON_FINITE / INVALID_SIZE (parameters), BUSY.
 //
 // # Safety
 // Pointers are NULL (reported) or valid; `params->sources` holds `n_sources` entries.

@@ -139,7 +139,7 @@ fn count(n: u64, what: &str) -> FfiResult<usize> {
 
 /// Writes the default parameters into `*out_params` (100 000 samples for the
 /// size deviation and for each side of the Hausdorff distance, seed 1); the
-/// caller has set its `struct_size` (`abgs_eval_params p = {sizeof p};`).
+/// caller has set its `struct_size` (`abgs_eval_params p = {.struct_size = sizeof p};`).
 ///
 /// # Safety
 /// `out_params` is NULL (reported) or holds `struct_size` writable bytes.

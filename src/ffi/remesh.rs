@@ -111,7 +111,7 @@ fn default_params() -> abgs_remesh_params {
 }
 
 /// Writes the default parameters into `*out_params`, whose `struct_size` the
-/// caller has set (`abgs_remesh_params p = {sizeof p};`).
+/// caller has set (`abgs_remesh_params p = {.struct_size = sizeof p};`).
 ///
 /// # Safety
 /// `out_params` is NULL (reported) or holds `struct_size` writable bytes.

@@ -176,7 +176,7 @@ fn default_params() -> abgs_simplify_params {
 struct SimplifyRecords(Vec<abgs_iteration_record>);
 
 /// Writes the default parameters into `*out_params`, whose `struct_size` the
-/// caller has set (`abgs_simplify_params p = {sizeof p};`).
+/// caller has set (`abgs_simplify_params p = {.struct_size = sizeof p};`).
 ///
 /// # Safety
 /// `out_params` is NULL (reported) or holds `struct_size` writable bytes.

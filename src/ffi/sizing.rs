@@ -153,7 +153,7 @@ fn default_params() -> abgs_size_params {
 }
 
 /// Writes the default parameters into `*out_params`, whose `struct_size` the
-/// caller has set (`abgs_size_params p = {sizeof p};`).
+/// caller has set (`abgs_size_params p = {.struct_size = sizeof p};`).
 ///
 /// # Safety
 /// `out_params` is NULL (reported) or holds `struct_size` writable bytes.

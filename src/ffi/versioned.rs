@@ -7,9 +7,9 @@
 //! header declares it* before handing the struct to the library, in or out:
 //!
 //! ```c
-//! abgs_simplify_params sp = {sizeof sp};  /* struct_size first, rest zero */
-//! abgs_simplify_params_default(&sp);       /* fills the defaults           */
-//! abgs_simplify_report rep = {sizeof rep};
+//! abgs_simplify_params sp = {.struct_size = sizeof sp};  /* rest zero   */
+//! abgs_simplify_params_default(&sp);                      /* the defaults */
+//! abgs_simplify_report rep = {.struct_size = sizeof rep};
 //! abgs_simplify(grid, &sp, &out, &rep);
 //! ```
 //!
