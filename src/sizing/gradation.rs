@@ -587,11 +587,24 @@ fn largest_admissible(
     t: f64,
 ) -> Option<f64> {
     let g = gram(px, pv, py)?;
+    // Lengths and sizes are taken in units of u, a power of two near the
+    // longest of e1, e2: the discriminant below is of degree six in lengths,
+    // which would underflow (overflow) in model units for models near 1e-50
+    // (1e50); a power of two rescales exactly, so the answer's bits scale
+    // with the model's.
+    let u = pow2_floor(g[0].max(g[2]).sqrt());
+    let (u2, u4) = (u * u, u * u * u * u);
+    let g = [g[0] / u2, g[1] / u2, g[2] / u2, g[3] / u4];
     // With z = hx − hv, δ = hy − hv: |pv − py|²·z² − 2δ(g11 − g12)·z + g11·δ² − t²·det = 0.
-    let delta = hy - hv;
+    let delta = (hy - hv) / u;
     let a = g[0] - 2.0 * g[1] + g[2];
     let b = delta * (g[0] - g[1]);
     let c = g[0] * delta * delta - t * t * g[3];
     let disc = b * b - a * c;
-    (disc >= 0.0 && a > 0.0).then(|| hv + (b + disc.sqrt()) / a)
+    (disc >= 0.0 && a > 0.0).then(|| hv + (b + disc.sqrt()) / a * u)
+}
+
+/// The largest power of two at most `x` (a positive normal number). O(1).
+fn pow2_floor(x: f64) -> f64 {
+    f64::from_bits(x.to_bits() & (0x7ff << 52))
 }
