@@ -195,21 +195,38 @@ fn obj(vertex0: &str, extra_face: &str) -> Vec<u8> {
 
 /// Simplify parameters from the defaults, edited by `f`, run on a sized cube;
 /// the parameter struct must come back unchanged.
-fn simplify_with(f: impl FnOnce(&mut abgs_simplify_params)) -> Outcome {
-    with_cube(true, |g| {
-        // SAFETY: zeroed is a valid value of this plain C struct.
-        let mut p: abgs_simplify_params = unsafe { std::mem::zeroed() };
-        p.struct_size = std::mem::size_of::<abgs_simplify_params>() as u32;
-        // SAFETY: a writable struct with struct_size set.
-        assert_eq!(
-            unsafe { abgs_simplify_params_default(&mut p) },
-            abgs_status::ABGS_OK
-        );
-        f(&mut p);
+/// A parameter struct of type `T` from the library's defaults
+/// (`default_fn`), with `struct_size` set first as the ABI asks.
+fn defaults<T: Copy>(default_fn: unsafe extern "C" fn(*mut T) -> abgs_status) -> T {
+    // SAFETY: all-zero bytes are a valid value of these plain C structs.
+    let mut p: T = unsafe { std::mem::zeroed() };
+    // SAFETY: every ABI struct begins with `uint32_t struct_size`.
+    unsafe {
+        std::ptr::write(
+            &mut p as *mut T as *mut u32,
+            std::mem::size_of::<T>() as u32,
+        )
+    };
+    // SAFETY: a writable struct with struct_size set.
+    assert_eq!(unsafe { default_fn(&mut p) }, abgs_status::ABGS_OK);
+    p
+}
+
+/// Runs a call that makes a grid from `params` (edited from the defaults by
+/// `edit`) on the cube; checks that `params` came back unchanged and that a
+/// failure leaves the out-grid NULL.
+fn make_with<T: Copy + std::fmt::Debug>(
+    sized: bool,
+    default_fn: unsafe extern "C" fn(*mut T) -> abgs_status,
+    edit: impl FnOnce(&mut T),
+    call: impl FnOnce(*mut abgs_grid, &T, &mut *mut abgs_grid) -> abgs_status,
+) -> Outcome {
+    with_cube(sized, |g| {
+        let mut p = defaults(default_fn);
+        edit(&mut p);
         let before = format!("{p:?}");
         let mut out = std::ptr::dangling_mut::<abgs_grid>();
-        // SAFETY: valid grid, params and out-pointer.
-        let st = unsafe { abgs_simplify(g, &p, &mut out, null_mut()) };
+        let st = call(g, &p, &mut out);
         assert_eq!(format!("{p:?}"), before, "params modified");
         let o = outcome(st);
         if st == abgs_status::ABGS_OK {
@@ -221,20 +238,28 @@ fn simplify_with(f: impl FnOnce(&mut abgs_simplify_params)) -> Outcome {
     })
 }
 
+fn simplify_with(f: impl FnOnce(&mut abgs_simplify_params)) -> Outcome {
+    make_with(true, abgs_simplify_params_default, f, |g, p, out| {
+        // SAFETY: valid grid, params and out-pointer.
+        unsafe { abgs_simplify(g, p, out, null_mut()) }
+    })
+}
+
+fn remesh_with(f: impl FnOnce(&mut abgs_remesh_params)) -> Outcome {
+    make_with(false, abgs_remesh_params_default, f, |g, p, out| {
+        // SAFETY: valid grid, params and out-pointer.
+        unsafe { abgs_grid_remesh(g, null(), p, out, null_mut()) }
+    })
+}
+
 fn size_with(f: impl FnOnce(&mut abgs_size_params, &mut abgs_size_source)) -> Outcome {
     with_cube(false, |g| {
-        // SAFETY: zeroed is a valid value of these plain C structs.
-        let (mut p, mut src): (abgs_size_params, abgs_size_source) =
-            unsafe { (std::mem::zeroed(), std::mem::zeroed()) };
-        p.struct_size = std::mem::size_of::<abgs_size_params>() as u32;
+        let mut p = defaults(abgs_size_params_default);
+        // SAFETY: zeroed is a valid value of this plain C struct.
+        let mut src: abgs_size_source = unsafe { std::mem::zeroed() };
         src.struct_size = std::mem::size_of::<abgs_size_source>() as u32;
         src.size = 0.1;
         src.radius = 0.2;
-        // SAFETY: a writable struct with struct_size set.
-        assert_eq!(
-            unsafe { abgs_size_params_default(&mut p) },
-            abgs_status::ABGS_OK
-        );
         f(&mut p, &mut src);
         if p.n_sources == 1 {
             p.sources = &src;
@@ -250,32 +275,6 @@ fn size_with(f: impl FnOnce(&mut abgs_size_params, &mut abgs_size_source)) -> Ou
             // SAFETY: valid grid, point and out-pointer.
             let q = unsafe { abgs_query_size(g, [0.5, 0.5, 0.5].as_ptr(), &mut h) };
             assert_eq!(q, abgs_status::ABGS_ERR_NO_SIZES);
-        }
-        o
-    })
-}
-
-fn remesh_with(f: impl FnOnce(&mut abgs_remesh_params)) -> Outcome {
-    with_cube(false, |g| {
-        // SAFETY: zeroed is a valid value of this plain C struct.
-        let mut p: abgs_remesh_params = unsafe { std::mem::zeroed() };
-        p.struct_size = std::mem::size_of::<abgs_remesh_params>() as u32;
-        // SAFETY: a writable struct with struct_size set.
-        assert_eq!(
-            unsafe { abgs_remesh_params_default(&mut p) },
-            abgs_status::ABGS_OK
-        );
-        f(&mut p);
-        let before = format!("{p:?}");
-        let mut out = std::ptr::dangling_mut::<abgs_grid>();
-        // SAFETY: valid grid, params and out-pointer.
-        let st = unsafe { abgs_grid_remesh(g, null(), &p, &mut out, null_mut()) };
-        assert_eq!(format!("{p:?}"), before, "params modified");
-        let o = outcome(st);
-        if st == abgs_status::ABGS_OK {
-            free(out);
-        } else {
-            assert!(out.is_null());
         }
         o
     })

@@ -50,14 +50,7 @@ pub struct abgs_grid_stats {
     pub memory_bytes: u64,
 }
 
-versioned!(
-    abgs_grid_stats,
-    184,
-    abgs_grid_stats {
-        struct_size: super::versioned::own_size::<abgs_grid_stats>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_grid_stats, 184);
 
 /// Builds a grid from caller arrays, which are copied (the caller keeps ownership).
 ///

@@ -89,14 +89,7 @@ pub struct abgs_evaluation {
 }
 
 versioned!(abgs_eval_params, 32, default_params());
-versioned!(
-    abgs_evaluation,
-    232,
-    abgs_evaluation {
-        struct_size: own_size::<abgs_evaluation>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_evaluation, 232);
 
 /// The library's defaults as a C struct.
 fn default_params() -> abgs_eval_params {

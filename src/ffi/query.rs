@@ -2,7 +2,7 @@
 
 use super::boundary::*;
 use super::grid::abgs_grid;
-use super::versioned::{check_out, own_size, versioned, write_out};
+use super::versioned::{check_out, versioned, write_out};
 
 /// Answer of `abgs_query_closest`.
 #[repr(C)]
@@ -22,14 +22,7 @@ pub struct abgs_hit {
     pub size: f64,
 }
 
-versioned!(
-    abgs_hit,
-    72,
-    abgs_hit {
-        struct_size: own_size::<abgs_hit>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_hit, 72);
 
 /// Size at `point` (3 doubles): exact closest point on the grid, barycentric
 /// interpolation there. Expected O(log F).

@@ -74,14 +74,7 @@ pub struct abgs_remesh_report {
 }
 
 versioned!(abgs_remesh_params, 48, default_params());
-versioned!(
-    abgs_remesh_report,
-    120,
-    abgs_remesh_report {
-        struct_size: own_size::<abgs_remesh_report>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_remesh_report, 120);
 
 /// What the remesher kept and reported, held in the new grid's handle (its
 /// provenance).

@@ -55,14 +55,7 @@ pub struct abgs_iteration_record {
     pub seconds: f64,
 }
 
-versioned!(
-    abgs_iteration_record,
-    96,
-    abgs_iteration_record {
-        struct_size: own_size::<abgs_iteration_record>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_iteration_record, 96);
 
 /// Called after every iteration that collapsed something, with its record and `user_data`; return 0 to
 /// go on, anything else to stop (the grid made so far is returned, valid).
@@ -141,14 +134,7 @@ pub struct abgs_simplify_report {
 }
 
 versioned!(abgs_simplify_params, 112, default_params());
-versioned!(
-    abgs_simplify_report,
-    96,
-    abgs_simplify_report {
-        struct_size: own_size::<abgs_simplify_report>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_simplify_report, 96);
 
 /// The library's defaults as a C struct.
 fn default_params() -> abgs_simplify_params {

@@ -112,23 +112,9 @@ pub struct abgs_size_report {
     pub seconds_contacts: f64,
 }
 
-versioned!(
-    abgs_size_source,
-    96,
-    abgs_size_source {
-        struct_size: own_size::<abgs_size_source>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_size_source, 96);
 versioned!(abgs_size_params, 112, default_params());
-versioned!(
-    abgs_size_report,
-    160,
-    abgs_size_report {
-        struct_size: own_size::<abgs_size_report>(),
-        ..Default::default()
-    }
-);
+versioned!(abgs_size_report, 160);
 
 /// The library's defaults as a C struct.
 fn default_params() -> abgs_size_params {

@@ -247,8 +247,20 @@ pub(crate) unsafe fn read_array<T: Versioned>(
 }
 
 /// Implements [`Versioned`] for a C struct:
-/// `versioned!(type, FIRST_SIZE, initial-expression)`.
+/// `versioned!(type, FIRST_SIZE, initial-expression)`, or
+/// `versioned!(type, FIRST_SIZE)` for a report whose initial value is all
+/// zeros (`Default`) with its `struct_size`.
 macro_rules! versioned {
+    ($t:ident, $first:expr) => {
+        $crate::ffi::versioned::versioned!(
+            $t,
+            $first,
+            $t {
+                struct_size: $crate::ffi::versioned::own_size::<$t>(),
+                ..Default::default()
+            }
+        );
+    };
     ($t:ty, $first:expr, $init:expr) => {
         // SAFETY: the type is #[repr(C)], starts with `struct_size: u32`, has
         // only integer / float / pointer fields, and the unit test
