@@ -71,7 +71,8 @@ pub struct Grid {
 impl Grid {
     /// Builds a grid from vertices, triangles and optional per-vertex sizes.
     ///
-    /// Errors on a non-finite coordinate, an out-of-range index, a size that is not
+    /// Errors on a non-finite coordinate (or one beyond
+    /// [`crate::geometry::MAX_COORDINATE`]), an out-of-range index, a size that is not
     /// finite and > 0, a size array of the wrong length, or when no triangle is
     /// left. Zero-area triangles are dropped and counted in [`Grid::report`].
     /// O(F log F).
@@ -406,8 +407,15 @@ mod tests {
             Err(Error::InvalidArgument(_))
         ));
         assert!(matches!(
-            Grid::from_arrays(v, vec![], None, &o),
+            Grid::from_arrays(v.clone(), vec![], None, &o),
             Err(Error::Empty(_))
+        ));
+        // Finite but beyond MAX_COORDINATE: squared distances would overflow.
+        let mut huge = v.clone();
+        huge[1][0] = 1e200;
+        assert!(matches!(
+            Grid::from_arrays(huge, t.clone(), None, &o),
+            Err(Error::NonFinite(_))
         ));
         let line = vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
         assert!(matches!(

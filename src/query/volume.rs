@@ -117,8 +117,8 @@ impl Grid {
     /// `H(x)` for gradation ratio `beta` (> 1): see the module documentation.
     pub fn query_volume(&self, x: [f64; 3], beta: f64) -> Result<VolumeHit> {
         let s = slope_from_beta(beta)?;
-        if !is_finite3(x) {
-            return Err(Error::NonFinite(format!("query point {x:?}")));
+        if !crate::geometry::is_coordinate3(x) {
+            return Err(super::non_finite_point(x));
         }
         self.require_sizes()?;
         Ok(self.volume_with_slope(x, s))
