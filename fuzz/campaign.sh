@@ -28,7 +28,7 @@ mkdir -p work/logs
 declare -A ROW
 status=0
 for t in "${TARGETS[@]}"; do
-    mkdir -p "work/$t" "artifacts/$t"
+    mkdir -p "work/$t" "artifacts/$t" "corpus/$t"
     log="work/logs/$t.log"
     before=$(ls "artifacts/$t" | wc -l)
     echo "fuzz: $t, $RUNS executions" >&2

@@ -18,7 +18,7 @@ trap 'rm -rf "$tmp"' EXIT
 fail=0
 start=$(date +%s)
 for t in "${ALL_TARGETS[@]}"; do
-    mkdir -p "$tmp/$t"
+    mkdir -p "$tmp/$t" "corpus/$t"
     # The regression inputs first (each must pass), then fuzzing from the seeds.
     if [ -d "regressions/$t" ] && [ -n "$(ls "regressions/$t")" ]; then
         if ! cargo +nightly fuzz run "${BUILD_FLAGS[@]}" "$t" "regressions/$t" -- \

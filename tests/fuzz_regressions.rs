@@ -49,3 +49,21 @@ fn vtu_huge_coordinates_are_refused() {
     let e = Grid::load(&regression("vtu", "huge_coordinates.vtu")).unwrap_err();
     assert!(matches!(e, Error::NonFinite(_)), "{e}");
 }
+
+/// msh22 / msh41: a `$NodeData` announcing 1.5·10^8 (or 10^16) string tags at the
+/// end of the file looped that many times on empty lines (a hang); the end of the
+/// file is now a parse error.
+#[test]
+fn msh_nodedata_string_tag_count_is_bounded_by_the_file() {
+    for target in ["msh22", "msh41"] {
+        let t = std::time::Instant::now();
+        let e = Grid::load(&regression(target, "nodedata_string_tag_count.msh")).unwrap_err();
+        assert!(matches!(e, Error::Parse { .. }), "{e}");
+        assert!(e.to_string().contains("string tags"), "{e}");
+        assert!(
+            t.elapsed().as_secs_f64() < 0.5,
+            "{target}: {:?}",
+            t.elapsed()
+        );
+    }
+}
