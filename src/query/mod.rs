@@ -54,7 +54,7 @@ impl Grid {
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;
         let size = match self.sizes() {
-            Some(s) => b[0] * s[t[0] as usize] + b[1] * s[t[1] as usize] + b[2] * s[t[2] as usize],
+            Some(s) => interpolate(t.map(|v| s[v as usize]), b),
             None => f64::NAN,
         };
         Ok(QueryHit {
@@ -107,6 +107,16 @@ impl Grid {
             Ok(())
         }
     }
+}
+
+/// The size at barycentric coordinates `b` of a triangle with corner sizes `h`,
+/// kept within `[min h, max h]`: the convex combination lies there exactly, but
+/// rounding can push it out, to 0 for subnormal sizes or to infinity for sizes
+/// near `f64::MAX` (both found by fuzzing), and a size must stay finite and > 0.
+#[inline]
+pub(crate) fn interpolate(h: [f64; 3], b: [f64; 3]) -> f64 {
+    let v = b[0] * h[0] + b[1] * h[1] + b[2] * h[2];
+    v.clamp(h[0].min(h[1]).min(h[2]), h[0].max(h[1]).max(h[2]))
 }
 
 /// Checks batch arguments: equal lengths and finite points.
