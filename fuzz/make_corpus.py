@@ -4,6 +4,10 @@
 format that the readers know. Deterministic: rerun it and commit the result.
 
 Usage: python3 fuzz/make_corpus.py   (from anywhere)
+
+The arrays_query seeds (structured input decoded by `arbitrary`) are not made
+here: they are five inputs that an early run of that target found, chosen
+because they build a grid of several triangles and make several calls.
 """
 import base64
 import os

@@ -176,6 +176,12 @@ pub fn run(input: &Input) {
         )
     };
     ok(st, "abgs_grid_from_arrays");
+    if crate::verbose() {
+        eprintln!(
+            "from_arrays: {st:?} ({nv} vertices, {nt} triangles), {} calls",
+            input.calls.len().min(16)
+        );
+    }
     let sizes = sizes.filter(|s| s.len() >= nv && nv > 0).map(|mut s| {
         s.truncate(nv);
         s

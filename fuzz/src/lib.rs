@@ -57,7 +57,7 @@ pub fn scratch(ext: &str) -> PathBuf {
 }
 
 /// Whether `ABGS_FUZZ_VERBOSE` is set: then each outcome is printed (to check seeds).
-fn verbose() -> bool {
+pub(crate) fn verbose() -> bool {
     static V: OnceLock<bool> = OnceLock::new();
     *V.get_or_init(|| std::env::var_os("ABGS_FUZZ_VERBOSE").is_some())
 }
