@@ -21,7 +21,7 @@ shift || true
 if [ $# -gt 0 ]; then TARGETS=("$@"); else TARGETS=("${ALL_TARGETS[@]}"); fi
 
 ensure_cargo_fuzz || exit 2
-nice -n 10 cargo +nightly fuzz build "${BUILD_FLAGS[@]}" || exit 2
+nice -n 10 "${FUZZ_CARGO[@]}" fuzz build "${BUILD_FLAGS[@]}" || exit 2
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 mkdir -p work/logs
 
@@ -33,7 +33,7 @@ for t in "${TARGETS[@]}"; do
     before=$(ls "artifacts/$t" | wc -l)
     echo "fuzz: $t, $RUNS executions" >&2
     start=$(date +%s)
-    nice -n 10 cargo +nightly fuzz run "${BUILD_FLAGS[@]}" "$t" "work/$t" "corpus/$t" -- \
+    nice -n 10 "${FUZZ_CARGO[@]}" fuzz run "${BUILD_FLAGS[@]}" "$t" "work/$t" "corpus/$t" -- \
         -runs="$RUNS" "${FUZZ_LIMITS[@]}" -print_final_stats=1 \
         -artifact_prefix="artifacts/$t/" >"$log" 2>&1
     rc=$?

@@ -11,7 +11,7 @@ source ./common.sh
 
 SECS=${1:-10}
 ensure_cargo_fuzz || exit 2
-nice -n 10 cargo +nightly fuzz build "${BUILD_FLAGS[@]}" || exit 2
+nice -n 10 "${FUZZ_CARGO[@]}" fuzz build "${BUILD_FLAGS[@]}" || exit 2
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -21,14 +21,14 @@ for t in "${ALL_TARGETS[@]}"; do
     mkdir -p "$tmp/$t" "corpus/$t"
     # The regression inputs first (each must pass), then fuzzing from the seeds.
     if [ -d "regressions/$t" ] && [ -n "$(ls "regressions/$t")" ]; then
-        if ! cargo +nightly fuzz run "${BUILD_FLAGS[@]}" "$t" "regressions/$t" -- \
+        if ! "${FUZZ_CARGO[@]}" fuzz run "${BUILD_FLAGS[@]}" "$t" "regressions/$t" -- \
             -runs=0 "${FUZZ_LIMITS[@]}" >"$tmp/$t.regressions.log" 2>&1; then
             echo "smoke: $t: a regression input fails again:" >&2
             tail -40 "$tmp/$t.regressions.log" >&2
             fail=1
         fi
     fi
-    if nice -n 10 cargo +nightly fuzz run "${BUILD_FLAGS[@]}" "$t" "$tmp/$t" "corpus/$t" -- \
+    if nice -n 10 "${FUZZ_CARGO[@]}" fuzz run "${BUILD_FLAGS[@]}" "$t" "$tmp/$t" "corpus/$t" -- \
         -max_total_time="$SECS" "${FUZZ_LIMITS[@]}" -print_final_stats=1 \
         -artifact_prefix="$tmp/$t-" >"$tmp/$t.log" 2>&1; then
         n=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$tmp/$t.log" | grep -o '[0-9]*$' | tail -1)
