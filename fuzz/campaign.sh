@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The fuzz campaign: builds every target, then runs each in turn (one fuzzer
 # process at a time, under nice) for RUNS executions, and records a row per target
-# in CAMPAIGN.md (between the TABLE markers; rows of targets not run are kept).
+# in CAMPAIGN.md as soon as it ends (between the TABLE markers; rows of targets
+# not run are kept).
 #
 # Usage: fuzz/campaign.sh [RUNS] [TARGET...]
 #   RUNS     executions per target (default 10000000)
@@ -25,16 +26,40 @@ nice -n 10 "${FUZZ_CARGO[@]}" fuzz build "${BUILD_FLAGS[@]}" || exit 2
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 mkdir -p work/logs
 
-declare -A ROW
+# Replaces (or adds) the row of target $1 in CAMPAIGN.md's table with $2.
+update_table() {
+    local md=CAMPAIGN.md tmp t
+    if [ ! -f "$md" ] || ! grep -q '^<!-- TABLE BEGIN' "$md"; then
+        printf '# Fuzz campaign\n\n<!-- TABLE BEGIN (written by campaign.sh) -->\n<!-- TABLE END -->\n' >>"$md"
+    fi
+    tmp=$(mktemp)
+    {
+        sed '/^<!-- TABLE BEGIN/q' "$md"
+        echo "| target | executions | exec/s | seconds | findings | commit, date |"
+        echo "|---|---:|---:|---:|---|---|"
+        for t in "${ALL_TARGETS[@]}"; do
+            if [ "$t" = "$1" ]; then
+                echo "$2"
+            else
+                sed -n '/^<!-- TABLE BEGIN/,/^<!-- TABLE END/p' "$md" | grep "^| $t |" || true
+            fi
+        done
+        sed -n '/^<!-- TABLE END/,$p' "$md"
+    } >"$tmp"
+    mv "$tmp" "$md"
+}
+
 status=0
 for t in "${TARGETS[@]}"; do
     mkdir -p "work/$t" "artifacts/$t" "corpus/$t"
     log="work/logs/$t.log"
     before=$(ls "artifacts/$t" | wc -l)
+    dict=()
+    if [ -f "dict/$t.dict" ]; then dict=(-dict="dict/$t.dict"); fi
     echo "fuzz: $t, $RUNS executions" >&2
     start=$(date +%s)
     nice -n 10 "${FUZZ_CARGO[@]}" fuzz run "${BUILD_FLAGS[@]}" "$t" "work/$t" "corpus/$t" -- \
-        -runs="$RUNS" "${FUZZ_LIMITS[@]}" -print_final_stats=1 \
+        -runs="$RUNS" "${FUZZ_LIMITS[@]}" "${dict[@]}" -print_final_stats=1 \
         -artifact_prefix="artifacts/$t/" >"$log" 2>&1
     rc=$?
     secs=$(( $(date +%s) - start ))
@@ -49,27 +74,6 @@ for t in "${TARGETS[@]}"; do
         what=0
     fi
     echo "fuzz: $t: $execs executions in ${secs}s ($rate/s), findings: $what" >&2
-    ROW[$t]="| $t | $execs | $rate | $secs | $what | $commit, $(date -u +%Y-%m-%d) |"
+    update_table "$t" "| $t | $execs | $rate | $secs | $what | $commit, $(date -u +%Y-%m-%d) |"
 done
-
-# Rewrite the table in CAMPAIGN.md, keeping the rows of targets not run now.
-md=CAMPAIGN.md
-if [ ! -f "$md" ] || ! grep -q '^<!-- TABLE BEGIN' "$md"; then
-    printf '# Fuzz campaign\n\n<!-- TABLE BEGIN (written by campaign.sh) -->\n<!-- TABLE END -->\n' >>"$md"
-fi
-tmp=$(mktemp)
-{
-    sed '/^<!-- TABLE BEGIN/q' "$md"
-    echo "| target | executions | exec/s | seconds | findings | commit, date |"
-    echo "|---|---:|---:|---:|---|---|"
-    for t in "${ALL_TARGETS[@]}"; do
-        if [ -n "${ROW[$t]:-}" ]; then
-            echo "${ROW[$t]}"
-        else
-            sed -n '/^<!-- TABLE BEGIN/,/^<!-- TABLE END/p' "$md" | grep "^| $t |" || true
-        fi
-    done
-    sed -n '/^<!-- TABLE END/,$p' "$md"
-} >"$tmp"
-mv "$tmp" "$md"
 exit $status

@@ -28,8 +28,10 @@ for t in "${ALL_TARGETS[@]}"; do
             fail=1
         fi
     fi
+    dict=()
+    if [ -f "dict/$t.dict" ]; then dict=(-dict="dict/$t.dict"); fi
     if nice -n 10 "${FUZZ_CARGO[@]}" fuzz run "${BUILD_FLAGS[@]}" "$t" "$tmp/$t" "corpus/$t" -- \
-        -max_total_time="$SECS" "${FUZZ_LIMITS[@]}" -print_final_stats=1 \
+        -max_total_time="$SECS" "${FUZZ_LIMITS[@]}" "${dict[@]}" -print_final_stats=1 \
         -artifact_prefix="$tmp/$t-" >"$tmp/$t.log" 2>&1; then
         n=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$tmp/$t.log" | grep -o '[0-9]*$' | tail -1)
         echo "smoke: $t ok (${n:-?} executions)"
