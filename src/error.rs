@@ -13,7 +13,8 @@ pub enum Error {
     /// An index (vertex, triangle, edge) is outside its valid range.
     #[error("index out of range: {0}")]
     OutOfRange(String),
-    /// A coordinate or parameter is NaN or infinite.
+    /// A coordinate or parameter is NaN or infinite (or, for a grid vertex or a
+    /// query point, beyond [`crate::geometry::MAX_COORDINATE`]).
     #[error("non-finite value: {0}")]
     NonFinite(String),
     /// A size value is not a finite number > 0.

@@ -349,9 +349,9 @@ fn cases() -> Vec<(
             c(Box::new(|| load_bytes("obj", &obj("inf 0 0", "")))),
         ),
         (
-            "OBJ at 1e308 (finite, overflowing extent)",
+            "OBJ at 1e308 (finite, beyond ±1e150)",
             ABGS_ERR_NON_FINITE,
-            "diagonal",
+            "1e150",
             c(Box::new(|| {
                 load_bytes(
                     "obj",
@@ -556,13 +556,25 @@ fn cases() -> Vec<(
             })),
         ),
         (
-            "coordinates at 1e308 overflow the extent",
+            "coordinates at 1e308 (beyond ±1e150)",
             ABGS_ERR_NON_FINITE,
-            "diagonal",
+            "1e150",
             c(Box::new({
                 let (v, t) = (v.clone(), t.clone());
                 move || {
                     let v: Vec<f64> = v.iter().map(|x| (x - 0.5) * 1.6e308).collect();
+                    from_arrays(&v, 8, &t, 12, None).0
+                }
+            })),
+        ),
+        (
+            "a cube at 1e100 (above the extent range)",
+            ABGS_ERR_INVALID_ARGUMENT,
+            "rescale",
+            c(Box::new({
+                let (v, t) = (v.clone(), t.clone());
+                move || {
+                    let v: Vec<f64> = v.iter().map(|x| x * 1e100).collect();
                     from_arrays(&v, 8, &t, 12, None).0
                 }
             })),

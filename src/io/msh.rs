@@ -280,6 +280,13 @@ fn node_data(lx: &mut Lexer<'_>, m: &mut Msh) -> Result<()> {
     lx.rest_of_line();
     let mut name = None;
     for _ in 0..nstr {
+        // `rest_of_line` returns "" at the end of the file: without this check a
+        // count of 10^16 string tags would loop that many times on nothing.
+        if lx.remaining() == 0 {
+            return Err(lx.err(format!(
+                "unexpected end of file in the {nstr} string tags of $NodeData"
+            )));
+        }
         let s = String::from_utf8_lossy(lx.rest_of_line())
             .trim()
             .to_string();

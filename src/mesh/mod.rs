@@ -75,9 +75,9 @@ pub struct Grid {
 /// not depend on its scale. Outside it, rescale the coordinates.
 pub const EXTENT_RANGE: [f64; 2] = [1e-75, 1e75];
 
-/// Checks a model's bounding-box diagonal against [`EXTENT_RANGE`]: NonFinite
-/// when it overflows, InvalidArgument when finite but outside (a single point,
-/// extent 0, is left to the degenerate-triangle checks, which report an empty
+/// Checks a model's bounding-box diagonal against [`EXTENT_RANGE`] (vertices
+/// are already within ±[`crate::geometry::MAX_COORDINATE`], so it is finite; a
+/// single point, extent 0, is left to the degenerate-triangle checks, which report an empty
 /// grid). The diagonal is bracketed by the largest side `m` (m ≤ d ≤ √3·m),
 /// which neither underflows nor overflows where the squared sum would.
 fn check_extent(bbox: &Aabb) -> Result<()> {
@@ -87,23 +87,17 @@ fn check_extent(bbox: &Aabb) -> Result<()> {
     if m == 0.0 || (m >= lo && diagonal <= hi) {
         return Ok(());
     }
-    let why =
-        "(rescale the coordinates) so that lengths to the fourth power stay finite and non-zero";
-    if diagonal.is_finite() {
-        Err(Error::InvalidArgument(format!(
-            "the model's bounding-box diagonal is {diagonal:e}; it must lie in [{lo:e}, {hi:e}] {why}"
-        )))
-    } else {
-        Err(Error::NonFinite(format!(
-            "the model's bounding-box diagonal overflows f64; it must lie in [{lo:e}, {hi:e}] {why}"
-        )))
-    }
+    Err(Error::InvalidArgument(format!(
+        "the model's bounding-box diagonal is {diagonal:e}; it must lie in [{lo:e}, {hi:e}] \
+         (rescale the coordinates) so that lengths to the fourth power stay finite and non-zero"
+    )))
 }
 
 impl Grid {
     /// Builds a grid from vertices, triangles and optional per-vertex sizes.
     ///
-    /// Errors on a non-finite coordinate, an out-of-range index, a size that is not
+    /// Errors on a non-finite coordinate (or one beyond
+    /// [`crate::geometry::MAX_COORDINATE`]), an out-of-range index, a size that is not
     /// finite and > 0, a size array of the wrong length, or when no triangle is
     /// left. Zero-area triangles are dropped and counted in [`Grid::report`].
     /// O(F log F).
@@ -439,8 +433,15 @@ mod tests {
             Err(Error::InvalidArgument(_))
         ));
         assert!(matches!(
-            Grid::from_arrays(v, vec![], None, &o),
+            Grid::from_arrays(v.clone(), vec![], None, &o),
             Err(Error::Empty(_))
+        ));
+        // Finite but beyond MAX_COORDINATE: squared distances would overflow.
+        let mut huge = v.clone();
+        huge[1][0] = 1e200;
+        assert!(matches!(
+            Grid::from_arrays(huge, t.clone(), None, &o),
+            Err(Error::NonFinite(_))
         ));
         let line = vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
         assert!(matches!(

@@ -81,11 +81,12 @@ impl ValidationReport {
 pub fn check_input(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<()> {
     if let Some(i) = vertices
         .iter()
-        .position(|v| !crate::geometry::is_finite3(*v))
+        .position(|v| !crate::geometry::is_coordinate3(*v))
     {
         return Err(Error::NonFinite(format!(
-            "vertex {i} has coordinates {:?}",
-            vertices[i]
+            "vertex {i} has coordinates {:?} (each must be finite and within ±{:e})",
+            vertices[i],
+            crate::geometry::MAX_COORDINATE
         )));
     }
     let n = vertices.len();

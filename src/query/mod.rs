@@ -14,7 +14,7 @@
 pub mod volume;
 
 use crate::error::{Error, Result};
-use crate::geometry::is_finite3;
+use crate::geometry::{is_coordinate3, MAX_COORDINATE};
 use crate::mesh::Grid;
 use rayon::prelude::*;
 
@@ -40,11 +40,12 @@ const BATCH_CHUNK: usize = 256;
 
 impl Grid {
     /// Closest point and interpolated size at `p`, with an optional triangle hint
-    /// (ignored when out of range). Errors only on a non-finite point.
+    /// (ignored when out of range). Errors only on a point that is not finite or
+    /// beyond [`MAX_COORDINATE`].
     /// Expected O(log F).
     pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Result<QueryHit> {
-        if !is_finite3(p) {
-            return Err(Error::NonFinite(format!("query point {p:?}")));
+        if !is_coordinate3(p) {
+            return Err(non_finite_point(p));
         }
         let hit = self
             .bvh()
@@ -53,7 +54,7 @@ impl Grid {
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;
         let size = match self.sizes() {
-            Some(s) => b[0] * s[t[0] as usize] + b[1] * s[t[1] as usize] + b[2] * s[t[2] as usize],
+            Some(s) => interpolate(t.map(|v| s[v as usize]), b),
             None => f64::NAN,
         };
         Ok(QueryHit {
@@ -65,7 +66,8 @@ impl Grid {
         })
     }
 
-    /// Size at `p` (surface mode). Errors on a non-finite point or a grid without sizes.
+    /// Size at `p` (surface mode). Errors on a non-finite point (or one beyond
+    /// [`MAX_COORDINATE`]) or a grid without sizes.
     pub fn query_size(&self, p: [f64; 3]) -> Result<f64> {
         self.require_sizes()?;
         Ok(self.closest(p, None)?.size)
@@ -107,6 +109,16 @@ impl Grid {
     }
 }
 
+/// The size at barycentric coordinates `b` of a triangle with corner sizes `h`,
+/// kept within `[min h, max h]`: the convex combination lies there exactly, but
+/// rounding can push it out, to 0 for subnormal sizes or to infinity for sizes
+/// near `f64::MAX` (both found by fuzzing), and a size must stay finite and > 0.
+#[inline]
+pub(crate) fn interpolate(h: [f64; 3], b: [f64; 3]) -> f64 {
+    let v = b[0] * h[0] + b[1] * h[1] + b[2] * h[2];
+    v.clamp(h[0].min(h[1]).min(h[2]), h[0].max(h[1]).max(h[2]))
+}
+
 /// Checks batch arguments: equal lengths and finite points.
 pub(crate) fn check_batch(points: &[[f64; 3]], out_len: usize) -> Result<()> {
     if out_len != points.len() {
@@ -115,13 +127,20 @@ pub(crate) fn check_batch(points: &[[f64; 3]], out_len: usize) -> Result<()> {
             points.len()
         )));
     }
-    if let Some(i) = points.iter().position(|p| !is_finite3(*p)) {
+    if let Some(i) = points.iter().position(|p| !is_coordinate3(*p)) {
         return Err(Error::NonFinite(format!(
-            "query point {i} is {:?}",
+            "query point {i} is {:?} (each coordinate must be finite and within ±{MAX_COORDINATE:e})",
             points[i]
         )));
     }
     Ok(())
+}
+
+/// The error for a query point that is not finite or beyond [`MAX_COORDINATE`].
+pub(crate) fn non_finite_point(p: [f64; 3]) -> Error {
+    Error::NonFinite(format!(
+        "query point {p:?} (each coordinate must be finite and within ±{MAX_COORDINATE:e})"
+    ))
 }
 
 #[cfg(test)]
@@ -179,5 +198,34 @@ mod tests {
             assert_eq!(*o, g.query_size(*p).unwrap());
         }
         assert!(g.query_sizes(&pts, &mut out[1..]).is_err());
+    }
+
+    #[test]
+    fn points_beyond_max_coordinate_are_refused() {
+        use crate::geometry::MAX_COORDINATE;
+        use crate::Error;
+        let g = plate();
+        // At the limit, far from the grid: still a size of the grid (seen from
+        // 1e150 away, the unit plate is a point: every triangle is at the same
+        // rounded distance, and the tie goes to the lowest index).
+        let s = g.query_size([MAX_COORDINATE, MAX_COORDINATE, 0.0]).unwrap();
+        assert!((1.0..=6.0).contains(&s), "{s}");
+        assert!(g
+            .query_volume([-MAX_COORDINATE, 0.0, 0.0], 1.2)
+            .unwrap()
+            .size
+            .is_finite());
+        let beyond = [0.0, 1.000_000_000_000_000_2 * MAX_COORDINATE, 0.0];
+        assert!(matches!(g.query_size(beyond), Err(Error::NonFinite(_))));
+        assert!(matches!(
+            g.query_volume(beyond, 1.2),
+            Err(Error::NonFinite(_))
+        ));
+        let mut out = [0.0; 2];
+        assert!(matches!(
+            g.query_sizes(&[[0.0; 3], beyond], &mut out),
+            Err(Error::NonFinite(_))
+        ));
+        assert_eq!(out, [0.0; 2], "nothing written on error");
     }
 }

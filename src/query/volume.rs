@@ -68,7 +68,15 @@ fn edge_min(x: [f64; 3], p: [f64; 3], q: [f64; 3], hp: f64, hq: f64, s: f64) -> 
 
 /// Exact minimum of `h(y) + s·|x − y|` over triangle (a, b, c) with vertex sizes
 /// `h`; returns (value, barycentric coordinates of the minimiser). O(1).
+///
+/// The value is kept at or above `min h`, its exact lower bound: rounding of
+/// `h(y)` could otherwise give 0 (or less) for subnormal sizes (found by fuzzing).
 pub fn triangle_min(x: [f64; 3], c: [[f64; 3]; 3], h: [f64; 3], s: f64) -> (f64, [f64; 3]) {
+    let (val, b) = triangle_min_unclamped(x, c, h, s);
+    (val.max(h[0].min(h[1]).min(h[2])), b)
+}
+
+fn triangle_min_unclamped(x: [f64; 3], c: [[f64; 3]; 3], h: [f64; 3], s: f64) -> (f64, [f64; 3]) {
     let e1 = sub(c[1], c[0]);
     let e2 = sub(c[2], c[0]);
     let (g11, g12, g22) = (dot(e1, e1), dot(e1, e2), dot(e2, e2));
@@ -117,8 +125,8 @@ impl Grid {
     /// `H(x)` for gradation ratio `beta` (> 1): see the module documentation.
     pub fn query_volume(&self, x: [f64; 3], beta: f64) -> Result<VolumeHit> {
         let s = slope_from_beta(beta)?;
-        if !is_finite3(x) {
-            return Err(Error::NonFinite(format!("query point {x:?}")));
+        if !crate::geometry::is_coordinate3(x) {
+            return Err(super::non_finite_point(x));
         }
         self.require_sizes()?;
         Ok(self.volume_with_slope(x, s))

@@ -1,0 +1,6 @@
+//! Fuzzes the .vtk reader through `abgs::Grid::load` (read, weld, validate, BVH).
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    abgs_fuzz::load("vtk", data);
+});
