@@ -1117,7 +1117,7 @@ fn bad_input_matrix() {
         table += &format!(
             "| {name} | {} | {} |\n",
             o.status.name().to_str().unwrap(),
-            o.message.replace('|', "/")
+            o.message.replace('|', "/").replace('\n', " ")
         );
         if o.status != *expect {
             failures.push(format!(
