@@ -133,3 +133,16 @@ fn sizes_near_f64_max_interpolate_to_a_finite_size() {
         assert!(h.is_finite() && h > 0.0, "{h} at {p:?}");
     }
 }
+
+/// ply: a binary file whose header ends up with an element of 1.3·10^14 entries
+/// and no properties (its name is defined twice, so the properties went to
+/// another element) hung: skipping it read "nothing" that many times. Such an
+/// element takes no bytes and is now passed over at once.
+#[test]
+fn ply_binary_element_without_properties_is_skipped_at_once() {
+    let t = std::time::Instant::now();
+    let r = Grid::load(&regression("ply", "element_without_properties.ply"));
+    assert!(t.elapsed().as_secs_f64() < 0.5, "{:?}", t.elapsed());
+    let e = r.unwrap_err();
+    assert!(matches!(e, Error::Parse { .. }), "{e}");
+}
