@@ -424,11 +424,11 @@ fn checked_sizes<'a>(grid: &'a Grid, what: &str) -> Result<&'a [f64]> {
     grid.sizes().ok_or(Error::NoSizes)
 }
 
-/// Barycentric interpolation of per-vertex `sizes` on triangle `tri` (the same
-/// expression as the surface query, so equal inputs give equal bits).
+/// Barycentric interpolation of per-vertex `sizes` on triangle `tri`: the
+/// surface query's own function, so equal inputs give equal bits.
 #[inline]
 fn interpolate(sizes: &[f64], tri: [u32; 3], b: [f64; 3]) -> f64 {
-    b[0] * sizes[tri[0] as usize] + b[1] * sizes[tri[1] as usize] + b[2] * sizes[tri[2] as usize]
+    crate::query::interpolate(tri.map(|v| sizes[v as usize]), b)
 }
 
 /// `h` when it is finite and > 0, else [`Error::InvalidSize`].
