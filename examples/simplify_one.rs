@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut params = SimplifyParams::default();
     if let Ok(t) = std::env::var("TAU_D") {
-        params.tau_d = t.parse()?;
+        params.tau_d = Some(t.parse()?);
     }
     let s = simplify(&grid, &params, Some(&mut cb))?;
     let r = &s.report;

@@ -42,7 +42,8 @@ int main(void) {
     abgs_simplify_params p = {.struct_size = sizeof p};
     CHECK_STATUS(abgs_simplify_params_default(&p), ABGS_OK);
     CHECK(p.method == ABGS_METHOD_LBO && p.fraction == 0.10 && p.pool_factor == 2.0);
-    CHECK(p.t_size == 1.2 && p.tau_d == 0.05 && p.max_distance == 0.0);
+    CHECK(p.t_size == 1.2 && p.tau_d == 0.0 && p.max_distance == 0.0);
+    CHECK(p.beta == 1.2 && p.clearance_fraction == 0.25);
     CHECK(p.max_iterations == 200 && p.repair == 1 && p.progress == NULL);
     CHECK_STATUS(abgs_simplify_params_default(NULL), ABGS_ERR_NULL);
     /* A struct whose struct_size was not set is refused, not overrun. */

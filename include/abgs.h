@@ -236,6 +236,15 @@ typedef struct {
   abgs_angle_stats angles_candidate;
   // Wall time of the evaluation, seconds.
   double seconds;
+  // 99th percentile of the size ratio.
+  double size_deviation_p99;
+  // Share of the size samples whose query landed on the wrong sheet
+  // (another body, or a face turned away; contacts left out).
+  double wrong_sheet;
+  // element_count_candidate / faces_candidate: mesh elements per background cell.
+  double elements_per_cell;
+  // element_count_reference / faces_reference.
+  double elements_per_cell_reference;
 } abgs_evaluation;
 
 // Answer of `abgs_query_closest`.
@@ -363,7 +372,9 @@ typedef struct {
   double pool_factor;
   // Largest size ratio a collapse may cause, > 1 (default 1.2).
   double t_size;
-  // Largest distance to the dense grid as a fraction of the local size, > 0 (default 0.05).
+  // 0 (default): the distance envelope is derived, Δd <= ½·ln(t_size)·h / ln(beta)
+  // (and the clearance term); > 0: the fixed rule Δd <= tau_d·h_loc in its
+  // place (the paper's is 0.05).
   double tau_d;
   // Largest distance to the dense grid in model units; 0 = no limit (default 0).
   double max_distance;
@@ -383,6 +394,11 @@ typedef struct {
   abgs_progress_fn progress;
   // Passed to `progress` unchanged.
   void *user_data;
+  // Gradation ratio the sizes were graded with, > 1 (default 1.2).
+  double beta;
+  // Each side of a thin wall or gap may move at most this fraction of its
+  // width, > 0 (default 0.25); 0 turns the clearance term off.
+  double clearance_fraction;
 } abgs_simplify_params;
 
 // What `abgs_simplify` did.

@@ -815,6 +815,26 @@ fn cases() -> Vec<(
             })),
         ),
         (
+            "simplify tau_d -1",
+            ABGS_ERR_INVALID_ARGUMENT,
+            "tau_d = -1 must be >= 0",
+            c(Box::new(|| simplify_with(|p| p.tau_d = -1.0))),
+        ),
+        (
+            "simplify beta 1",
+            ABGS_ERR_INVALID_ARGUMENT,
+            "beta",
+            c(Box::new(|| simplify_with(|p| p.beta = 1.0))),
+        ),
+        (
+            "simplify clearance_fraction NaN",
+            ABGS_ERR_NON_FINITE,
+            "clearance_fraction",
+            c(Box::new(|| {
+                simplify_with(|p| p.clearance_fraction = f64::NAN)
+            })),
+        ),
+        (
             "simplify max_iterations 0",
             ABGS_ERR_INVALID_ARGUMENT,
             "max_iterations",

@@ -282,9 +282,14 @@ fn edge_scores_follow_their_definition() {
             assert_eq!(s.y, 1.0);
             continue;
         }
-        let y = (0.5 * ((s.ds - 1.0) / (p.t_size - 1.0)).max(s.dd_rel / p.tau_d)).min(1.0);
+        let y = (0.5 * ((s.ds - 1.0) / (p.t_size - 1.0)).max(s.de)).min(1.0);
         assert!((y - s.y).abs() < 1e-12, "{s:?}");
-        assert_eq!(s.y < 0.5, s.ds < p.t_size && s.dd_rel < p.tau_d);
+        assert_eq!(s.y < 0.5, s.ds < p.t_size && s.de < 1.0);
+        // The envelope is at most the derived size term, ½·ln(T)/ln(β)·h
+        // (= h/2 at the defaults), with h at most 0.4 here.
+        if s.dd_rel > 0.0 {
+            assert!(s.de * 0.5 * 0.4 >= s.dd_rel * 0.1 * 0.999, "{s:?}");
+        }
         collapsible += usize::from(s.y < 0.5);
         // An edge between two corners is never valid.
         let [a, b] = s.vertices.map(|i| dense.vertices()[i as usize]);
@@ -313,7 +318,15 @@ fn bad_input_is_an_error() {
             ..Default::default()
         },
         SimplifyParams {
-            tau_d: f64::NAN,
+            tau_d: Some(f64::NAN),
+            ..Default::default()
+        },
+        SimplifyParams {
+            beta: 1.0,
+            ..Default::default()
+        },
+        SimplifyParams {
+            clearance_fraction: 0.0,
             ..Default::default()
         },
         SimplifyParams {

@@ -46,7 +46,11 @@ pub fn evaluation_json(e: &Evaluation) -> Value {
         "vertices_reference": e.vertices_reference,
         "vertices_candidate": e.vertices_candidate,
         "reduction": e.reduction,
-        "size_deviation": {"mean": d.mean, "p95": d.p95, "max": d.max, "samples": d.samples},
+        "size_deviation": {"mean": d.mean, "p95": d.p95, "p99": d.p99, "max": d.max,
+                           "samples": d.samples},
+        "wrong_sheet": d.wrong_sheet,
+        "elements_per_cell": e.elements_per_cell,
+        "elements_per_cell_reference": e.elements_per_cell_reference,
         "hausdorff": e.hausdorff,
         "hausdorff_relative": e.hausdorff_relative,
         "diagonal": e.diagonal,
@@ -107,8 +111,12 @@ fn print_table(reference: &Path, candidate: &Path, e: &Evaluation) {
     );
     println!("reduction       {:.2} %", 100.0 * e.reduction);
     println!(
-        "size deviation  mean {:.4}   p95 {:.4}   max {:.4}   ({} samples; max(hc/hr, hr/hc))",
-        d.mean, d.p95, d.max, d.samples
+        "size deviation  mean {:.4}   p95 {:.4}   p99 {:.4}   max {:.4}   ({} samples; max(hc/hr, hr/hc))",
+        d.mean, d.p95, d.p99, d.max, d.samples
+    );
+    println!(
+        "wrong sheet     {:.3e} of the samples (query on another body or a face turned away)",
+        d.wrong_sheet
     );
     println!(
         "hausdorff       {:.4e}   {:.4} % of the diagonal {:.6}",
@@ -121,6 +129,10 @@ fn print_table(reference: &Path, candidate: &Path, e: &Evaluation) {
         e.element_count_reference,
         e.element_count_candidate,
         100.0 * e.element_count_change
+    );
+    println!(
+        "elements/cell   reference {:.2}   candidate {:.2}   (candidate's element count / faces)",
+        e.elements_per_cell_reference, e.elements_per_cell
     );
     println!(
         "angles (deg)   {:>8} {:>8} {:>8} {:>9} {:>8} {:>8}",

@@ -88,7 +88,7 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
     };
     let fields = stage("sizes", &mut times, || sizing::compute(&dense, &sp))?;
     dense.set_sizes(fields.h.clone())?;
-    let params = a.lbo.params(a.feature_angle, true);
+    let params = a.lbo.params(a.feature_angle, a.beta, true);
     let t = Instant::now();
     let simplified = run_lbo(&dense, &params)?;
     times.push(("simplify".into(), t.elapsed().as_secs_f64()));
@@ -188,13 +188,15 @@ fn print_summary(
 ) {
     let row = |name: &str, e: &abgs::metrics::Evaluation| {
         eprintln!(
-            "{name:<9} faces {:>9} -> {:>8}  reduction {:5.1} %  size deviation mean {:.3} p95 {:.3} max {:.3}  hausdorff {:.3} %  elements {:+.2} %",
+            "{name:<9} faces {:>9} -> {:>8}  elements/cell {:.1}  size deviation mean {:.3} p95 {:.3} p99 {:.3} max {:.3}  wrong sheet {:.1e}  hausdorff {:.3} %  elements {:+.2} %",
             e.faces_reference,
             e.faces_candidate,
-            100.0 * e.reduction,
+            e.elements_per_cell,
             e.size_deviation.mean,
             e.size_deviation.p95,
+            e.size_deviation.p99,
             e.size_deviation.max,
+            e.size_deviation.wrong_sheet,
             100.0 * e.hausdorff_relative,
             100.0 * e.element_count_change
         );

@@ -30,9 +30,14 @@ pub struct LboArgs {
     /// Largest size ratio a collapse may cause (T_size).
     #[arg(long, default_value_t = SimplifyParams::default().t_size)]
     pub t_size: f64,
-    /// Largest distance to the dense grid as a fraction of the local size (τ_d).
-    #[arg(long, default_value_t = SimplifyParams::default().tau_d)]
-    pub tau_d: f64,
+    /// Fixed distance rule Δd ≤ τ_d·h_loc (the paper's is 0.05) in place of
+    /// the derived Δd ≤ ½·ln(T_size)·h / ln β (default: derived).
+    #[arg(long)]
+    pub tau_d: Option<f64>,
+    /// Each side of a thin wall or gap may move at most this fraction of its
+    /// width (κ; 0 turns the clearance term off).
+    #[arg(long, default_value_t = SimplifyParams::default().clearance_fraction)]
+    pub clearance: f64,
     /// Largest distance to the dense grid in model units (default: no limit).
     #[arg(long)]
     pub max_distance: Option<f64>,
@@ -42,12 +47,19 @@ pub struct LboArgs {
 }
 
 impl LboArgs {
-    /// The library parameters, with the feature angle and repair switch given.
-    pub fn params(&self, feature_angle_deg: f64, repair: bool) -> SimplifyParams {
+    /// The library parameters, with the feature angle, the sizes' gradation
+    /// ratio and the repair switch given.
+    pub fn params(&self, feature_angle_deg: f64, beta: f64, repair: bool) -> SimplifyParams {
         SimplifyParams {
             fraction: self.fraction,
             t_size: self.t_size,
             tau_d: self.tau_d,
+            beta,
+            clearance_fraction: if self.clearance > 0.0 {
+                self.clearance
+            } else {
+                f64::INFINITY
+            },
             max_distance: self.max_distance,
             max_iterations: self.max_iterations,
             feature_angle_deg,
@@ -69,12 +81,16 @@ pub struct SimplifyArgs {
     /// No local repair (relaxation, flips) after each batch.
     #[arg(long)]
     pub no_repair: bool,
+    /// Gradation ratio β the sizes were graded with.
+    #[arg(long, default_value_t = SimplifyParams::default().beta)]
+    pub beta: f64,
 }
 
 impl SimplifyArgs {
     /// The library parameters.
     pub fn params(&self) -> SimplifyParams {
-        self.lbo.params(self.feature_angle, !self.no_repair)
+        self.lbo
+            .params(self.feature_angle, self.beta, !self.no_repair)
     }
 }
 
@@ -83,7 +99,9 @@ pub fn params_json(p: &SimplifyParams) -> Value {
     json!({
         "method": "lbo",
         "fraction": p.fraction, "pool_factor": p.pool_factor, "t_size": p.t_size,
-        "tau_d": p.tau_d, "max_distance": p.max_distance, "max_iterations": p.max_iterations,
+        "tau_d": p.tau_d, "beta": p.beta,
+        "clearance_fraction": if p.clearance_fraction.is_finite() { json!(p.clearance_fraction) } else { Value::Null },
+        "max_distance": p.max_distance, "max_iterations": p.max_iterations,
         "feature_angle_deg": p.feature_angle_deg, "corner_angle_deg": p.corner_angle_deg,
         "max_normal_turn_deg": p.max_normal_turn_deg, "max_angle_deg": p.max_angle_deg,
         "repair": p.repair,

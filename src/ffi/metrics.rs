@@ -86,6 +86,15 @@ pub struct abgs_evaluation {
     pub angles_candidate: abgs_angle_stats,
     /// Wall time of the evaluation, seconds.
     pub seconds: f64,
+    /// 99th percentile of the size ratio.
+    pub size_deviation_p99: f64,
+    /// Share of the size samples whose query landed on the wrong sheet
+    /// (another body, or a face turned away; contacts left out).
+    pub wrong_sheet: f64,
+    /// element_count_candidate / faces_candidate: mesh elements per background cell.
+    pub elements_per_cell: f64,
+    /// element_count_reference / faces_reference.
+    pub elements_per_cell_reference: f64,
 }
 
 versioned!(abgs_eval_params, 32, default_params());
@@ -205,6 +214,10 @@ pub unsafe extern "C" fn abgs_evaluate(
             angles_reference: e.angles_reference.into(),
             angles_candidate: e.angles_candidate.into(),
             seconds: e.seconds,
+            size_deviation_p99: e.size_deviation.p99,
+            wrong_sheet: e.size_deviation.wrong_sheet,
+            elements_per_cell: e.elements_per_cell,
+            elements_per_cell_reference: e.elements_per_cell_reference,
         };
         // SAFETY: checked above.
         unsafe { write_out(out_evaluation, &ev, "out_evaluation") }

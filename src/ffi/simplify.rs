@@ -80,7 +80,9 @@ pub struct abgs_simplify_params {
     pub pool_factor: f64,
     /// Largest size ratio a collapse may cause, > 1 (default 1.2).
     pub t_size: f64,
-    /// Largest distance to the dense grid as a fraction of the local size, > 0 (default 0.05).
+    /// 0 (default): the distance envelope is derived, Δd <= ½·ln(t_size)·h / ln(beta)
+    /// (and the clearance term); > 0: the fixed rule Δd <= tau_d·h_loc in its
+    /// place (the paper's is 0.05).
     pub tau_d: f64,
     /// Largest distance to the dense grid in model units; 0 = no limit (default 0).
     pub max_distance: f64,
@@ -100,6 +102,11 @@ pub struct abgs_simplify_params {
     pub progress: abgs_progress_fn,
     /// Passed to `progress` unchanged.
     pub user_data: *mut c_void,
+    /// Gradation ratio the sizes were graded with, > 1 (default 1.2).
+    pub beta: f64,
+    /// Each side of a thin wall or gap may move at most this fraction of its
+    /// width, > 0 (default 0.25); 0 turns the clearance term off.
+    pub clearance_fraction: f64,
 }
 
 /// What `abgs_simplify` did.
@@ -145,7 +152,7 @@ fn default_params() -> abgs_simplify_params {
         fraction: d.fraction,
         pool_factor: d.pool_factor,
         t_size: d.t_size,
-        tau_d: d.tau_d,
+        tau_d: d.tau_d.unwrap_or(0.0),
         max_distance: 0.0,
         max_iterations: d.max_iterations as u32,
         feature_angle_deg: d.feature_angle_deg,
@@ -155,6 +162,8 @@ fn default_params() -> abgs_simplify_params {
         repair: 1,
         progress: None,
         user_data: std::ptr::null_mut(),
+        beta: d.beta,
+        clearance_fraction: d.clearance_fraction,
     }
 }
 
@@ -199,6 +208,8 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
         (p.corner_angle_deg, "corner_angle_deg"),
         (p.max_normal_turn_deg, "max_normal_turn_deg"),
         (p.max_angle_deg, "max_angle_deg"),
+        (p.beta, "beta"),
+        (p.clearance_fraction, "clearance_fraction"),
     ] {
         if !x.is_finite() {
             return err(
@@ -207,14 +218,17 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
             );
         }
     }
-    if p.max_distance < 0.0 {
-        return err(
-            abgs_status::ABGS_ERR_INVALID_ARGUMENT,
-            format!(
-                "max_distance = {} must be >= 0 (0 = no limit)",
-                p.max_distance
-            ),
-        );
+    for (x, what) in [
+        (p.max_distance, "max_distance"),
+        (p.tau_d, "tau_d"),
+        (p.clearance_fraction, "clearance_fraction"),
+    ] {
+        if x < 0.0 {
+            return err(
+                abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+                format!("{what} = {x} must be >= 0 (0 = off)"),
+            );
+        }
     }
     if p.max_iterations == 0 {
         return err(
@@ -226,7 +240,13 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
         fraction: p.fraction,
         pool_factor: p.pool_factor,
         t_size: p.t_size,
-        tau_d: p.tau_d,
+        tau_d: (p.tau_d > 0.0).then_some(p.tau_d),
+        beta: p.beta,
+        clearance_fraction: if p.clearance_fraction > 0.0 {
+            p.clearance_fraction
+        } else {
+            f64::INFINITY
+        },
         max_distance: (p.max_distance > 0.0).then_some(p.max_distance),
         max_iterations: p.max_iterations as usize,
         feature_angle_deg: p.feature_angle_deg,

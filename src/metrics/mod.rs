@@ -4,8 +4,14 @@
 //!
 //! - **reduction** `1 − F_c / F_r`;
 //! - **size deviation**: the ratio `max(h_c/h_r, h_r/h_c)` at points sampled
-//!   uniformly on the reference (mean, 95th percentile, max), `h_r` interpolated
-//!   on the sample's own reference triangle, `h_c` a surface query on the candidate;
+//!   uniformly on the reference (mean, 95th and 99th percentile, max), `h_r`
+//!   interpolated on the sample's own reference triangle, `h_c` a surface query
+//!   on the candidate;
+//! - **wrong-sheet share**: the share of those samples whose query lands on
+//!   another body or on a face turned away (see [`sheets`]);
+//! - **elements per background cell**: the estimated element count with the
+//!   candidate's sizes over the candidate's face count, the number a mesher's
+//!   user reads (how many mesh triangles one grid cell sizes);
 //! - **geometric fidelity**: the symmetric sampled Hausdorff distance, absolute and
 //!   relative to the reference's bounding-box diagonal;
 //! - **estimated element count** `(4/√3) ∫ h⁻² dA` over the reference surface by
@@ -22,10 +28,12 @@ use crate::geometry::{closest_point_triangle, triangle_area, Aabb};
 use crate::mesh::stats::percentile;
 use crate::mesh::Grid;
 use crate::sampling::surface_points;
+use crate::simplify::envelope::CONTACT_FRACTION;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+mod sheets;
 #[cfg(test)]
 mod tests;
 
@@ -62,10 +70,15 @@ pub struct SizeDeviation {
     pub mean: f64,
     /// 95th percentile of the ratio (nearest rank).
     pub p95: f64,
+    /// 99th percentile of the ratio (nearest rank).
+    pub p99: f64,
     /// Largest ratio.
     pub max: f64,
     /// Number of samples.
     pub samples: usize,
+    /// Share of the samples whose query landed on the wrong sheet (another
+    /// body, or a face turned away; contacts left out).
+    pub wrong_sheet: f64,
 }
 
 /// Distribution of the smallest and largest angle per face, in degrees
@@ -113,6 +126,11 @@ pub struct Evaluation {
     pub element_count_candidate: f64,
     /// `element_count_candidate / element_count_reference − 1`.
     pub element_count_change: f64,
+    /// `element_count_candidate / faces_candidate`: mesh elements per
+    /// background cell.
+    pub elements_per_cell: f64,
+    /// `element_count_reference / faces_reference`: the same for the reference.
+    pub elements_per_cell_reference: f64,
     /// Angles of the reference.
     pub angles_reference: AngleStats,
     /// Angles of the candidate.
@@ -156,6 +174,8 @@ pub fn evaluate(reference: &Grid, candidate: &Grid, params: &EvalParams) -> Resu
         element_count_reference,
         element_count_candidate,
         element_count_change: element_count_candidate / element_count_reference - 1.0,
+        elements_per_cell: element_count_candidate / fc as f64,
+        elements_per_cell_reference: element_count_reference / fr as f64,
         angles_reference: angle_stats(reference),
         angles_candidate: angle_stats(candidate),
         seconds: t0.elapsed().as_secs_f64(),
@@ -165,11 +185,13 @@ pub fn evaluate(reference: &Grid, candidate: &Grid, params: &EvalParams) -> Resu
 /// Size ratio `max(h_c/h_r, h_r/h_c)` at `samples` points sampled uniformly (by
 /// area) on `reference` with `seed`: `h_r` interpolated at the point's exact
 /// barycentric coordinates on its own reference triangle, `h_c` the candidate's
-/// surface query ([`Grid::closest`]). Equal sizes give exactly 1.
+/// surface query ([`Grid::closest`]). Equal sizes give exactly 1. Also the
+/// share of those queries that land on the wrong sheet (see [`sheets`]; the
+/// contact distance is [`CONTACT_FRACTION`] of the reference's diagonal).
 ///
 /// Errors when a grid has no sizes or triangles, when `samples` is 0, or when a
 /// size that is not finite and > 0 is met. Parallel, deterministic.
-/// O(F_r + n log F_r + n log F_c + n log n).
+/// O(F_r + F_c log F_r + n log F_r + n log F_c + n log n).
 pub fn size_deviation(
     reference: &Grid,
     candidate: &Grid,
@@ -190,6 +212,12 @@ pub fn size_deviation(
         .into_iter()
         .map(|i| pts[i as usize])
         .collect();
+    let sheets = sheets::Sheets::new(
+        reference,
+        candidate,
+        reference.bbox().diagonal() * CONTACT_FRACTION,
+    );
+    let wrong = std::sync::atomic::AtomicUsize::new(0);
     let mut ratios: Vec<f64> = pts
         .par_chunks(SAMPLE_CHUNK)
         .map(|chunk| {
@@ -207,6 +235,9 @@ pub fn size_deviation(
                     let hr = positive(interpolate(rs, tri, cp.bary), "reference", p)?;
                     let hit = candidate.closest(p, hint)?;
                     hint = Some(hit.triangle);
+                    if sheets.wrong(p, f, hit.triangle, hit.bary) {
+                        wrong.fetch_add(1, Ordering::Relaxed);
+                    }
                     let hc = positive(hit.size, "candidate", p)?;
                     Ok(if hc == hr {
                         1.0
@@ -223,8 +254,10 @@ pub fn size_deviation(
     Ok(SizeDeviation {
         mean,
         p95: percentile(&ratios, 0.95),
+        p99: percentile(&ratios, 0.99),
         max: ratios[ratios.len() - 1],
         samples: ratios.len(),
+        wrong_sheet: wrong.into_inner() as f64 / ratios.len() as f64,
     })
 }
 

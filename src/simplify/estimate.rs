@@ -4,6 +4,7 @@
 //! the unit-free score `y`. Read-only on the mesh, so candidates are
 //! estimated in parallel.
 
+use super::envelope::SizeTerm;
 use super::target::Target;
 use crate::geometry::{add, closest_point_triangle, cross, dot, lerp, norm, scale, sub};
 use crate::mesh::halfedge::{
@@ -16,8 +17,10 @@ use crate::remesh::ops::reliable_normal;
 pub struct Limits {
     /// Largest size ratio allowed (`T_size`, > 1).
     pub t_size: f64,
-    /// Largest distance to the target, as a fraction of `h_loc` (`τ_d`).
-    pub tau_d: f64,
+    /// The size term of the distance envelope (see [`super::envelope`]).
+    pub size_term: SizeTerm,
+    /// The clearance term's fraction `κ` (∞: no clearance term).
+    pub kappa: f64,
     /// Largest distance to the target in model units (∞ when unset).
     pub max_distance: f64,
     /// Cosine of the largest turn of a face normal.
@@ -36,6 +39,9 @@ pub struct Estimate {
     pub ds: f64,
     /// Largest distance to the target over the samples (NaN when invalid).
     pub dd: f64,
+    /// Largest ratio of a distance to the envelope there (≤ 1 inside; NaN
+    /// when invalid).
+    pub de: f64,
     /// Smaller target size at the two ends.
     pub h_loc: f64,
     /// Score in [0, 1]; `< 0.5` ⇔ collapsible.
@@ -57,6 +63,7 @@ impl Estimate {
             valid: false,
             ds: f64::NAN,
             dd: f64::NAN,
+            de: f64::NAN,
             h_loc,
             y: 1.0,
             halfedge: NONE,
@@ -73,10 +80,45 @@ impl Estimate {
     }
 }
 
-/// The unit-free score `y = min(1, ½·max((Δs−1)/(T−1), Δd/(τ_d·h_loc), Δd/max_distance))`.
-pub fn score(ds: f64, dd: f64, h_loc: f64, lim: &Limits) -> f64 {
+/// What sampling a set of triangles found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sampled {
+    /// Largest size ratio, either way (≥ 1).
+    pub ds: f64,
+    /// Largest distance to the target.
+    pub dd: f64,
+    /// Largest distance relative to the envelope at its landing point.
+    pub de: f64,
+}
+
+impl Sampled {
+    /// Nothing sampled yet.
+    pub const NONE: Sampled = Sampled {
+        ds: 1.0,
+        dd: 0.0,
+        de: 0.0,
+    };
+
+    /// Takes in a distance `d` with envelope `allow` there.
+    #[inline]
+    pub fn distance(&mut self, d: f64, allow: f64) {
+        self.dd = self.dd.max(d);
+        if d > 0.0 {
+            self.de = self.de.max(d / allow);
+        }
+    }
+
+    /// The score of what was found.
+    pub fn score(&self, lim: &Limits) -> f64 {
+        score(self.ds, self.de, self.dd, lim)
+    }
+}
+
+/// The unit-free score `y = min(1, ½·max((Δs−1)/(T−1), Δe, Δd/max_distance))`,
+/// `Δe` the largest distance relative to the envelope.
+pub fn score(ds: f64, de: f64, dd: f64, lim: &Limits) -> f64 {
     let a = (ds - 1.0) / (lim.t_size - 1.0);
-    let b = dd / (lim.tau_d * h_loc);
+    let b = de;
     let c = if lim.max_distance.is_finite() {
         dd / lim.max_distance
     } else {
@@ -106,8 +148,9 @@ pub struct FanTri {
 /// sizes: `n = clamp(⌈2·L/h_min⌉, 5, 16)` divisions, so samples are at most
 /// about `h_min/2` apart) and returns
 /// `(Δs, Δd)`: the largest ratio of interpolated to target size, either way,
-/// and the largest distance to the target patch. Stops as soon as the score
-/// reaches `exit_at` (the values are then lower bounds). O(samples · log F).
+/// and the largest distance to the target patch, absolute and relative to the
+/// envelope where it lands. Stops as soon as the score reaches `exit_at` (the
+/// values are then lower bounds). O(samples · log F).
 pub fn sample_fan(
     target: &Target,
     tris: &[FanTri],
@@ -115,9 +158,8 @@ pub fn sample_fan(
     lim: &Limits,
     exit_at: f64,
     hint: &mut u32,
-) -> (f64, f64) {
-    let mut ds: f64 = 1.0;
-    let mut dd: f64 = 0.0;
+) -> Sampled {
+    let mut out = Sampled::NONE;
     for t in tris {
         let longest = (0..3)
             .map(|k| norm(sub(t.p[k], t.p[(k + 1) % 3])))
@@ -136,7 +178,11 @@ pub fn sample_fan(
                 let p = add(add(scale(t.p[0], a), scale(t.p[1], b)), scale(t.p[2], c));
                 let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
                 let Some(hit) = target.on_patch(p, t.patch, *hint) else {
-                    return (f64::INFINITY, f64::INFINITY);
+                    return Sampled {
+                        ds: f64::INFINITY,
+                        dd: f64::INFINITY,
+                        de: f64::INFINITY,
+                    };
                 };
                 *hint = hit.index;
                 let r = if s_data > 0.0 && hit.size > 0.0 {
@@ -144,17 +190,18 @@ pub fn sample_fan(
                 } else {
                     f64::INFINITY
                 };
-                if r > ds || hit.dist > dd {
-                    ds = ds.max(r);
-                    dd = dd.max(hit.dist);
-                    if score(ds, dd, h_loc, lim) >= exit_at {
-                        return (ds, dd);
-                    }
+                let before = out;
+                out.ds = out.ds.max(r);
+                if hit.dist > 0.0 {
+                    out.distance(hit.dist, target.allowance(hit.index, hit.size, h_loc, lim));
+                }
+                if out != before && out.score(lim) >= exit_at {
+                    return out;
                 }
             }
         }
     }
-    (ds, dd)
+    out
 }
 
 fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
@@ -372,37 +419,46 @@ fn evaluate(
         return invalid;
     }
     // The removed vertex (and the kept one's old place) must stay close to
-    // the new surface.
-    let mut dd: f64 = 0.0;
-    for q in [Some(pv), moved.then_some(pw)].into_iter().flatten() {
+    // the new surface: within the envelope at the target triangle it came from.
+    let mut found = Sampled::NONE;
+    for (q, at) in [(pv, v), (pw, w)] {
+        if at == w && !moved {
+            continue;
+        }
         let d = fan
             .iter()
             .map(|t| closest_point_triangle(q, t.p[0], t.p[1], t.p[2]).dist2)
             .fold(f64::INFINITY, f64::min);
         if d.is_finite() {
-            dd = dd.max(d.sqrt());
+            let tri = mesh.vertex_hint[at as usize];
+            found.distance(d.sqrt(), target.allowance(tri, h_loc, h_loc, lim));
         }
     }
     if mesh.vertex_flags[v as usize] & V_FEATURE != 0 && line_neighbour != NONE {
         let line = mesh.edge_line[mesh.edge(h) as usize];
         if line != NONE {
             let pu = mesh.positions[line_neighbour as usize];
-            dd = dd.max(target.chord_distance(pos, pu, line, 4));
+            let tri = mesh.vertex_hint[v as usize];
+            found.distance(
+                target.chord_distance(pos, pu, line, 4),
+                target.allowance(tri, h_loc, h_loc, lim),
+            );
         }
     }
     let mut sample_hint = hint;
-    let (ds, dd_s) = if score(1.0, dd, h_loc, lim) >= exit_at {
-        (1.0, 0.0)
-    } else {
-        sample_fan(target, &fan, h_loc, lim, exit_at, &mut sample_hint)
-    };
-    let dd = dd.max(dd_s);
+    if found.score(lim) < exit_at {
+        let s = sample_fan(target, &fan, h_loc, lim, exit_at, &mut sample_hint);
+        found.ds = s.ds;
+        found.dd = found.dd.max(s.dd);
+        found.de = found.de.max(s.de);
+    }
     Estimate {
         valid: true,
-        ds,
-        dd,
+        ds: found.ds,
+        dd: found.dd,
+        de: found.de,
         h_loc,
-        y: score(ds, dd, h_loc, lim),
+        y: found.score(lim),
         halfedge: h,
         position: pos,
         size,

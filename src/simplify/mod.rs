@@ -26,6 +26,7 @@
 //! Deterministic: estimates are computed in parallel but applied in a fixed
 //! order, so the output bits do not depend on the thread count.
 
+pub mod envelope;
 mod estimate;
 mod repair;
 mod select;
@@ -50,9 +51,18 @@ pub struct SimplifyParams {
     pub pool_factor: f64,
     /// Largest size ratio a collapse may cause (`T_size`, default 1.2).
     pub t_size: f64,
-    /// Largest distance to the target as a fraction of the local size
-    /// (`τ_d`, default 0.05).
-    pub tau_d: f64,
+    /// Fixed distance rule `Δd ≤ τ_d·h_loc` in place of the derived
+    /// misprojection term (`None`, the default: `Δd ≤ ½·ln(T_size)·h / ln β`,
+    /// see [`envelope`]). The paper's rule is `Some(0.05)`.
+    pub tau_d: Option<f64>,
+    /// Gradation ratio β the sizes were graded with (default 1.2, the sizing
+    /// default): the field's slope `ln β` bounds how much a misprojection
+    /// changes a size.
+    pub beta: f64,
+    /// Each side of a thin wall or gap may move at most this fraction of the
+    /// gap's width (`κ`, default 0.25; `f64::INFINITY` turns the clearance
+    /// term off).
+    pub clearance_fraction: f64,
     /// Largest distance to the target in model units (`None`: no limit).
     pub max_distance: Option<f64>,
     /// Most iterations (default 200).
@@ -78,7 +88,9 @@ impl Default for SimplifyParams {
             fraction: 0.10,
             pool_factor: 2.0,
             t_size: 1.2,
-            tau_d: 0.05,
+            tau_d: None,
+            beta: 1.2,
+            clearance_fraction: envelope::DEFAULT_CLEARANCE_FRACTION,
             max_distance: None,
             max_iterations: 200,
             feature_angle_deg: 30.0,
@@ -97,7 +109,13 @@ impl SimplifyParams {
         within(self.fraction, 1e-9, 1.0, "fraction")?;
         within(self.pool_factor, 1.0, 1e6, "pool_factor")?;
         within(self.t_size, 1.0 + 1e-9, 1e9, "t_size")?;
-        within(self.tau_d, 1e-12, 1e9, "tau_d")?;
+        if let Some(t) = self.tau_d {
+            within(t, 1e-12, 1e9, "tau_d")?;
+        }
+        within(self.beta, 1.0 + 1e-9, 1e9, "beta")?;
+        if self.clearance_fraction != f64::INFINITY {
+            within(self.clearance_fraction, 1e-9, 1e9, "clearance_fraction")?;
+        }
         if let Some(d) = self.max_distance {
             within(d, f64::MIN_POSITIVE, f64::MAX, "max_distance")?;
         }
@@ -108,9 +126,17 @@ impl SimplifyParams {
     }
 
     fn limits(&self) -> Limits {
+        let size_term = match self.tau_d {
+            Some(t) => envelope::SizeTerm::Fixed(t),
+            None => envelope::SizeTerm::Derived {
+                budget: 0.5 * self.t_size.ln(),
+                slope: self.beta.ln(),
+            },
+        };
         Limits {
             t_size: self.t_size,
-            tau_d: self.tau_d,
+            size_term,
+            kappa: self.clearance_fraction,
             max_distance: self.max_distance.unwrap_or(f64::INFINITY),
             cos_turn: self.max_normal_turn_deg.to_radians().cos(),
             max_angle_deg: self.max_angle_deg,
@@ -204,6 +230,8 @@ pub struct EdgeScore {
     pub ds: f64,
     /// `Δd / h_loc` (NaN when invalid).
     pub dd_rel: f64,
+    /// Largest distance relative to the envelope (≤ 1 inside; NaN when invalid).
+    pub de: f64,
     /// The collapse passes the topological and geometric checks.
     pub valid: bool,
     /// The score `y` (1 when invalid).
@@ -216,6 +244,7 @@ struct TargetParts {
     features: Features,
     lines: FeatureLines,
     seg_sizes: Vec<[f64; 2]>,
+    envelope: envelope::Envelope,
 }
 
 impl TargetParts {
@@ -227,6 +256,7 @@ impl TargetParts {
             face_patch: &self.features.face_patch,
             lines: &self.lines,
             seg_sizes: &self.seg_sizes,
+            envelope: &self.envelope,
         }
     }
 }
@@ -252,12 +282,15 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
         .iter()
         .map(|s| s.map(|v| mesh.vertex_size[v as usize]))
         .collect();
+    let lim = params.limits();
+    let envelope = envelope::Envelope::compute(grid, sizes, &features, lim.size_term, lim.kappa);
     Ok((
         mesh,
         TargetParts {
             features,
             lines,
             seg_sizes,
+            envelope,
         },
     ))
 }
@@ -495,6 +528,7 @@ pub fn edge_scores(grid: &Grid, params: &SimplifyParams) -> Result<Vec<EdgeScore
             vertices,
             ds: f64::NAN,
             dd_rel: f64::NAN,
+            de: f64::NAN,
             valid: false,
             y: 1.0,
         })
@@ -525,6 +559,7 @@ pub fn edge_scores(grid: &Grid, params: &SimplifyParams) -> Result<Vec<EdgeScore
         if est.valid {
             s.ds = est.ds;
             s.dd_rel = est.dd / est.h_loc;
+            s.de = est.de;
         }
     }
     Ok(out)

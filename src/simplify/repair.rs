@@ -7,7 +7,7 @@
 //! never undoes what the estimation guaranteed. Moved vertices take their
 //! size from the target (step 6).
 
-use super::estimate::{face_ok, max_angle_deg, sample_fan, score, FanTri, Limits};
+use super::estimate::{face_ok, max_angle_deg, sample_fan, FanTri, Limits};
 use super::target::Target;
 use crate::geometry::{add, closest_point_triangle, cross, dot, lerp, norm, scale, sub};
 use crate::mesh::halfedge::{
@@ -151,8 +151,12 @@ fn propose(mesh: &HalfedgeMesh, target: &Target, v: u32, lim: &Limits) -> Option
         mesh.vertex_hint[v as usize]
     };
     let mut sample_hint = hint;
-    let (ds, dd) = sample_fan(target, &fan, h_loc, lim, 0.5, &mut sample_hint);
-    (score(ds, dd.max(back), h_loc, lim) < 0.5).then_some(Move {
+    let mut found = sample_fan(target, &fan, h_loc, lim, 0.5, &mut sample_hint);
+    found.distance(
+        back,
+        target.allowance(mesh.vertex_hint[v as usize], h_loc, h_loc, lim),
+    );
+    (found.score(lim) < 0.5).then_some(Move {
         v,
         p,
         size: hit.size,
@@ -242,8 +246,8 @@ pub fn flip_around(
         ];
         let h_loc = sa.min(sb).min(sc).min(sd);
         let mut hint = mesh.vertex_hint[a as usize];
-        let (ds, dd) = sample_fan(target, &fan, h_loc, lim, 0.5, &mut hint);
-        if score(ds, dd, h_loc, lim) >= 0.5 || mesh.flip(e).is_err() {
+        let found = sample_fan(target, &fan, h_loc, lim, 0.5, &mut hint);
+        if found.score(lim) >= 0.5 || mesh.flip(e).is_err() {
             continue;
         }
         touched.extend([a, b, c, d]);

@@ -4,6 +4,8 @@
 //! patch or line the projected point belongs to, so a thin wall or a narrow
 //! gap never mixes sizes or geometry of its two sides.
 
+use super::envelope::Envelope;
+use super::estimate::Limits;
 use crate::geometry::lerp;
 use crate::mesh::Grid;
 use crate::remesh::reference::FeatureLines;
@@ -34,9 +36,24 @@ pub struct Target<'a> {
     pub lines: &'a FeatureLines,
     /// Target sizes at the two ends of each line segment.
     pub seg_sizes: &'a [[f64; 2]],
+    /// Gradient and clearance per target triangle.
+    pub envelope: &'a Envelope,
 }
 
 impl Target<'_> {
+    /// How far the simplified grid may lie from the target at target triangle
+    /// `tri` (`NONE`: unknown, the size term with no gradient and no
+    /// clearance), the target size being `h` there and `h_loc` at the edge
+    /// (see [`super::envelope`]). O(1).
+    #[inline]
+    pub fn allowance(&self, tri: u32, h: f64, h_loc: f64, lim: &Limits) -> f64 {
+        let (g, c) = match self.envelope.gradient.get(tri as usize) {
+            Some(&g) => (g, self.envelope.clearance[tri as usize]),
+            None => (0.0, f64::INFINITY),
+        };
+        lim.size_term.allowance(h, h_loc, g).min(lim.kappa * c)
+    }
+
     /// Closest point of `p` on patch `patch` (anywhere on the target when the
     /// patch is empty), starting from triangle `hint`. O(log F) typically.
     pub fn on_patch(&self, p: [f64; 3], patch: u32, hint: u32) -> Option<Hit> {

@@ -23,6 +23,10 @@ use crate::mesh::{Features, Grid};
 use std::f64::consts::PI;
 use std::time::Instant;
 
+/// Default `hmin` as a fraction of the bounding-box diagonal (1/2000); also
+/// the default contact gap: sheets closer than this are in contact, not a gap.
+pub const DEFAULT_HMIN_FRACTION: f64 = 1.0 / 2000.0;
+
 /// Most rounds of (share sizes at contacts, grade again) after the first gradation.
 const CONTACT_ROUNDS: usize = 4;
 /// A contact size lowered by less than this (relative) does not call for another round.
@@ -112,7 +116,7 @@ impl SizeParams {
         };
         pos(self.n_circle, "n_circle")?;
         pos(self.n_gap, "n_gap")?;
-        let hmin = self.hmin.unwrap_or(diagonal / 2000.0);
+        let hmin = self.hmin.unwrap_or(diagonal * DEFAULT_HMIN_FRACTION);
         let hmax = self.hmax.unwrap_or(diagonal / 10.0);
         pos(hmin, "hmin")?;
         pos(hmax, "hmax")?;

@@ -15,11 +15,31 @@ use crate::mesh::Grid;
 use rayon::prelude::*;
 
 /// Cosine below which a hit face counts as facing back.
-const FACING_BACK: f64 = -0.2;
+pub(crate) const FACING_BACK: f64 = -0.2;
 
 /// Smallest gap per vertex (`+inf` where no opposite wall lies within `max_gap`).
 /// O(V log F), parallel over vertices.
 pub fn gaps(grid: &Grid, normals: &PatchNormals, contact_gap: f64, max_gap: f64) -> Vec<f64> {
+    gaps_with(grid, normals, contact_gap, |_| max_gap)
+}
+
+/// [`gaps`] with a limit per vertex (`limit[v]`: rays from `v` stop there).
+/// O(V log F), parallel over vertices.
+pub fn gaps_within(
+    grid: &Grid,
+    normals: &PatchNormals,
+    contact_gap: f64,
+    limit: &[f64],
+) -> Vec<f64> {
+    gaps_with(grid, normals, contact_gap, |v| limit[v])
+}
+
+fn gaps_with(
+    grid: &Grid,
+    normals: &PatchNormals,
+    contact_gap: f64,
+    max_gap: impl Fn(usize) -> f64 + Sync,
+) -> Vec<f64> {
     let v = grid.vertices();
     let topo = grid.topology();
     let bvh = grid.bvh();
@@ -27,6 +47,7 @@ pub fn gaps(grid: &Grid, normals: &PatchNormals, contact_gap: f64, max_gap: f64)
         .into_par_iter()
         .map(|vi| {
             let own = topo.faces_of_vertex(vi);
+            let max_gap = max_gap(vi);
             let mut best = f64::INFINITY;
             let range = normals.range(vi);
             // On a feature line or corner, rays along one patch normal graze the
