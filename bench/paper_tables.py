@@ -185,7 +185,7 @@ def main():
     for m, x in r.items():
         g = x["gmsh"]
         if not g:
-            rows.append([m, "missing"] + ["–"] * 8)
+            rows.append([m, "missing"] + ["–"] * 9)
             continue
         base = g.get("dense_triangles")
         for tag, c in cases:
@@ -194,7 +194,9 @@ def main():
                      "stl": f"raw STL ({int(g['stl_faces'])} f)",
                      "postview": "dense grid as MSH PostView"}[c]
             calls = g[c + "_calls"]
+            faces = g[("dense" if c == "postview" else c) + "_faces"]
             rows.append([m, f"({tag}) {label}", int(g[c + "_triangles"]),
+                         f"{g[c + '_triangles'] / faces:.1f}" if faces else "–",
                          pct(g[c + "_triangles"] / base - 1, 1) if base else "–",
                          f"{int(calls)}" if calls else "–", num(g[c + "_seconds"], "{:.3f}"),
                          f"{g[c + '_callback_s']:.3f} ({100 * g[c + '_callback_s'] / g[c + '_seconds']:.0f} %)" if calls else "–",
@@ -211,9 +213,10 @@ def main():
               "thread); (c): sizes computed and graded on the STL's own vertices (`abgs_compute_size`, "
               "defaults, as `abgs run` on the dense grid); (d): the dense grid saved by abgs as MSH "
               "($NodeData `size`), merged into its own model and used as a PostView background field. "
+              "Triangles / cell: mesh triangles per background face (what one cell sizes). "
               "Δ: triangles against (a). Edge / h_dense: every mesh edge's length over the dense field at its "
               "midpoint, mean [p5, p95] (1 = the mesh follows the dense field).\n")
-    md.append(table(["model", "background", "triangles", "Δ vs (a)", "callback calls", "meshing s",
+    md.append(table(["model", "background", "triangles", "triangles / cell", "Δ vs (a)", "callback calls", "meshing s",
                      "in callback s", "ns / call", "edge / h_dense"], rows))
     md.append("Background fields against the dense one (`abgs_evaluate`: size deviation at points on the "
               "dense grid, estimated element count change, Hausdorff / diagonal):\n")

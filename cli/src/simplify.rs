@@ -44,6 +44,12 @@ pub struct LboArgs {
     /// Most iterations.
     #[arg(long = "max-iter", default_value_t = SimplifyParams::default().max_iterations)]
     pub max_iterations: usize,
+    /// Largest angle of a new triangle, degrees.
+    #[arg(long, default_value_t = SimplifyParams::default().max_angle_deg)]
+    pub max_angle: f64,
+    /// Largest turn of a face normal per collapse, move or flip, degrees.
+    #[arg(long, default_value_t = SimplifyParams::default().max_normal_turn_deg)]
+    pub max_normal_turn: f64,
 }
 
 impl LboArgs {
@@ -62,6 +68,8 @@ impl LboArgs {
             },
             max_distance: self.max_distance,
             max_iterations: self.max_iterations,
+            max_angle_deg: self.max_angle,
+            max_normal_turn_deg: self.max_normal_turn,
             feature_angle_deg,
             repair,
             ..Default::default()
@@ -138,6 +146,12 @@ pub fn report_json(s: &Simplified) -> Value {
             StopReason::Cancelled => "cancelled",
         },
         "seconds": r.seconds,
+        "binding": {
+            "free": r.binding.free, "topology": r.binding.topology, "feature": r.binding.feature,
+            "degenerate": r.binding.degenerate, "normal_turn": r.binding.normal_turn,
+            "max_angle": r.binding.max_angle, "size": r.binding.size,
+            "distance": r.binding.distance, "max_distance": r.binding.max_distance,
+        },
         "iterations": iterations_json(&r.iterations),
     })
 }

@@ -30,6 +30,32 @@ pub struct Limits {
     pub max_angle_deg: f64,
 }
 
+/// What keeps an edge from collapsing: the first check that failed, or for a
+/// valid collapse the largest term of its score (`Free` when collapsible).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub enum Binding {
+    /// Collapsible (`y < 0.5`).
+    #[default]
+    Free,
+    /// The mesh forbids it: a deleted or locked edge, a link condition, a
+    /// valence or boundary rule.
+    Topology,
+    /// Feature rules: a corner, two feature vertices off one line.
+    Feature,
+    /// A new face would be degenerate (no reliable normal).
+    Degenerate,
+    /// A face normal would turn past the limit.
+    NormalTurn,
+    /// A new face's largest angle would pass the limit.
+    MaxAngle,
+    /// The sampled size ratio (`Δs ≥ T_size`).
+    Size,
+    /// The distance envelope.
+    Distance,
+    /// The absolute distance limit.
+    MaxDistance,
+}
+
 /// The estimate of one edge collapse.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
@@ -54,11 +80,13 @@ pub struct Estimate {
     pub size: f64,
     /// Target triangle near the kept vertex (its next hint).
     pub hint: u32,
+    /// What keeps it from collapsing (`Free` when collapsible).
+    pub binding: Binding,
 }
 
 impl Estimate {
-    /// An invalid collapse (score 1).
-    pub fn invalid(h_loc: f64) -> Estimate {
+    /// An invalid collapse (score 1), refused by `why`.
+    pub fn invalid(h_loc: f64, why: Binding) -> Estimate {
         Estimate {
             valid: false,
             ds: f64::NAN,
@@ -70,6 +98,7 @@ impl Estimate {
             position: [f64::NAN; 3],
             size: f64::NAN,
             hint: NONE,
+            binding: why,
         }
     }
 
@@ -111,6 +140,26 @@ impl Sampled {
     /// The score of what was found.
     pub fn score(&self, lim: &Limits) -> f64 {
         score(self.ds, self.de, self.dd, lim)
+    }
+
+    /// The term that sets the score (`Free` when it is below ½).
+    pub fn binding(&self, lim: &Limits) -> Binding {
+        if self.score(lim) < 0.5 {
+            return Binding::Free;
+        }
+        let a = (self.ds - 1.0) / (lim.t_size - 1.0);
+        let c = if lim.max_distance.is_finite() {
+            self.dd / lim.max_distance
+        } else {
+            0.0
+        };
+        if !(a < self.de.max(c)) {
+            Binding::Size
+        } else if !(self.de < c) {
+            Binding::Distance
+        } else {
+            Binding::MaxDistance
+        }
     }
 }
 
@@ -218,22 +267,31 @@ pub fn max_angle_deg(p: [[f64; 3]; 3]) -> f64 {
 /// Checks a face that moves from corners `old` to `new`: non-degenerate, its
 /// normal within the turn limit of the old one (or of `fallback` where the
 /// old one is noise), and no largest angle above the limit unless it was
-/// already there.
-pub fn face_ok(old: [[f64; 3]; 3], new: [[f64; 3]; 3], fallback: [f64; 3], lim: &Limits) -> bool {
+/// already there. `Err` names the check that failed.
+pub fn face_ok(
+    old: [[f64; 3]; 3],
+    new: [[f64; 3]; 3],
+    fallback: [f64; 3],
+    lim: &Limits,
+) -> Result<(), Binding> {
     let Some(n_new) = unit(cross(sub(new[1], new[0]), sub(new[2], new[0]))) else {
-        return false;
+        return Err(Binding::Degenerate);
     };
     if reliable_normal(new[0], new[1], new[2]).is_none() {
-        return false;
+        return Err(Binding::Degenerate);
     }
     let n_old = reliable_normal(old[0], old[1], old[2]).or_else(|| unit(fallback));
     if let Some(n_old) = n_old {
         if dot(n_new, n_old) < lim.cos_turn {
-            return false;
+            return Err(Binding::NormalTurn);
         }
     }
     let m = max_angle_deg(new);
-    m <= lim.max_angle_deg || m <= max_angle_deg(old)
+    if m <= lim.max_angle_deg || m <= max_angle_deg(old) {
+        Ok(())
+    } else {
+        Err(Binding::MaxAngle)
+    }
 }
 
 fn is_fixed(mesh: &HalfedgeMesh, v: u32) -> bool {
@@ -260,7 +318,7 @@ pub fn estimate(
     let [a, b] = mesh.edge_vertices(e);
     let h_loc = mesh.vertex_size[a as usize].min(mesh.vertex_size[b as usize]);
     if mesh.edge_deleted(e) || mesh.edge_flags[e as usize] & E_LOCKED != 0 {
-        return Estimate::invalid(h_loc);
+        return Estimate::invalid(h_loc, Binding::Topology);
     }
     // Half-edge 2e runs a → b: collapsing it removes a.
     let (ha, hb) = (2 * e, 2 * e + 1);
@@ -281,7 +339,7 @@ pub fn estimate(
                 mesh.face(hb)
             };
             if f == NONE {
-                return Estimate::invalid(h_loc);
+                return Estimate::invalid(h_loc, Binding::Topology);
             }
             let mid = lerp(mesh.positions[a as usize], mesh.positions[b as usize], 0.5);
             match target.on_patch(
@@ -290,31 +348,33 @@ pub fn estimate(
                 mesh.vertex_hint[b as usize],
             ) {
                 Some(hit) => vec![(ha, hit.point, hit.size, hit.index)],
-                None => return Estimate::invalid(h_loc),
+                None => return Estimate::invalid(h_loc, Binding::Topology),
             }
         }
         (false, true) => vec![keep(ha)],
         (true, false) => vec![keep(hb)],
         (true, true) => {
             if mesh.edge_flags[e as usize] & E_FEATURE == 0 {
-                return Estimate::invalid(h_loc);
+                return Estimate::invalid(h_loc, Binding::Feature);
             }
             match (is_fixed(mesh, a), is_fixed(mesh, b)) {
-                (true, true) => return Estimate::invalid(h_loc),
+                (true, true) => return Estimate::invalid(h_loc, Binding::Feature),
                 (false, true) => vec![keep(ha)],
                 (true, false) => vec![keep(hb)],
                 (false, false) => vec![keep(ha), keep(hb)],
             }
         }
     };
-    let mut best = Estimate::invalid(h_loc);
+    let mut best: Option<Estimate> = None;
     for (h, pos, size, hint) in options {
         let est = evaluate(mesh, target, h, pos, size, hint, h_loc, lim, exit_at);
-        if est.valid && (!best.valid || est.y < best.y) {
-            best = est;
-        }
+        best = match best {
+            Some(b) if b.valid && !(est.valid && est.y < b.y) => Some(b),
+            Some(b) if !b.valid && !est.valid => Some(b),
+            _ => Some(est),
+        };
     }
-    best
+    best.unwrap_or(Estimate::invalid(h_loc, Binding::Topology))
 }
 
 /// Area-weighted normal of the faces of `v` on `patch`.
@@ -330,7 +390,7 @@ fn star_normal(mesh: &HalfedgeMesh, v: u32, patch: u32) -> [f64; 3] {
 
 /// The faces around `v` with `v` moved to `p` (size `size`), skipping those
 /// that contain `skip` (they vanish in the collapse), with validity checks.
-/// Appends to `fan`; false when a face fails [`face_ok`].
+/// Appends to `fan`; `Err` when a face fails [`face_ok`].
 #[allow(clippy::too_many_arguments)]
 fn moved_faces(
     mesh: &HalfedgeMesh,
@@ -340,7 +400,7 @@ fn moved_faces(
     size: f64,
     lim: &Limits,
     fan: &mut Vec<FanTri>,
-) -> bool {
+) -> Result<(), Binding> {
     for f in mesh.vertex_faces(v) {
         let fv = mesh.face_vertices(f);
         if fv.contains(&skip) {
@@ -355,9 +415,7 @@ fn moved_faces(
             }
         });
         let patch = mesh.face_patch[f as usize];
-        if !face_ok(old, new, star_normal(mesh, v, patch), lim) {
-            return false;
-        }
+        face_ok(old, new, star_normal(mesh, v, patch), lim)?;
         fan.push(FanTri {
             p: new,
             h: fv.map(|x| {
@@ -370,7 +428,7 @@ fn moved_faces(
             patch,
         });
     }
-    true
+    Ok(())
 }
 
 /// Estimates collapsing half-edge `h` (removing its origin) with the kept
@@ -387,9 +445,9 @@ fn evaluate(
     lim: &Limits,
     exit_at: f64,
 ) -> Estimate {
-    let invalid = Estimate::invalid(h_loc);
+    let invalid = |why| Estimate::invalid(h_loc, why);
     if !mesh.can_collapse(h) {
-        return invalid;
+        return invalid(Binding::Topology);
     }
     let v = mesh.from_vertex(h);
     let w = mesh.to_vertex(h);
@@ -403,7 +461,7 @@ fn evaluate(
             continue;
         }
         if w_locked && mesh.vertex_flags[u as usize] & V_LOCKED != 0 {
-            return invalid;
+            return invalid(Binding::Topology);
         }
         if mesh.edge_flags[mesh.edge(o) as usize] & E_FEATURE != 0 {
             line_neighbour = u;
@@ -411,12 +469,14 @@ fn evaluate(
     }
     let mut fan: Vec<FanTri> = Vec::with_capacity(12);
     // The faces of v that survive, with v replaced by w at pos.
-    if !moved_faces(mesh, v, w, pos, size, lim, &mut fan) {
-        return invalid;
+    if let Err(why) = moved_faces(mesh, v, w, pos, size, lim, &mut fan) {
+        return invalid(why);
     }
     let moved = pos != pw;
-    if moved && !moved_faces(mesh, w, v, pos, size, lim, &mut fan) {
-        return invalid;
+    if moved {
+        if let Err(why) = moved_faces(mesh, w, v, pos, size, lim, &mut fan) {
+            return invalid(why);
+        }
     }
     // The removed vertex (and the kept one's old place) must stay close to
     // the new surface: within the envelope at the target triangle it came from.
@@ -459,6 +519,7 @@ fn evaluate(
         de: found.de,
         h_loc,
         y: found.score(lim),
+        binding: found.binding(lim),
         halfedge: h,
         position: pos,
         size,

@@ -32,7 +32,7 @@ mod repair;
 mod select;
 mod target;
 
-pub use estimate::{Estimate, Limits};
+pub use estimate::{Binding, Estimate, Limits};
 pub use target::{Hit, Target};
 
 use crate::error::{Error, Result};
@@ -186,6 +186,47 @@ pub enum StopReason {
     Cancelled,
 }
 
+/// For the edges of a simplified grid, what keeps each from collapsing (see
+/// [`Binding`]): the census that says which check set the grid's coarseness.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct BindingCounts {
+    /// Still collapsible (left by the iteration limit or a cancel).
+    pub free: usize,
+    /// Mesh rules (link condition, locked, boundary).
+    pub topology: usize,
+    /// Feature rules (corners, vertices on two lines).
+    pub feature: usize,
+    /// A new face would be degenerate.
+    pub degenerate: usize,
+    /// A face normal would turn past `max_normal_turn_deg`.
+    pub normal_turn: usize,
+    /// A new face's largest angle would pass `max_angle_deg`.
+    pub max_angle: usize,
+    /// The sampled size ratio.
+    pub size: usize,
+    /// The distance envelope.
+    pub distance: usize,
+    /// The absolute distance limit.
+    pub max_distance: usize,
+}
+
+impl BindingCounts {
+    fn add(&mut self, b: Binding) {
+        let slot = match b {
+            Binding::Free => &mut self.free,
+            Binding::Topology => &mut self.topology,
+            Binding::Feature => &mut self.feature,
+            Binding::Degenerate => &mut self.degenerate,
+            Binding::NormalTurn => &mut self.normal_turn,
+            Binding::MaxAngle => &mut self.max_angle,
+            Binding::Size => &mut self.size,
+            Binding::Distance => &mut self.distance,
+            Binding::MaxDistance => &mut self.max_distance,
+        };
+        *slot += 1;
+    }
+}
+
 /// What a simplification did.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct SimplifyReport {
@@ -207,6 +248,10 @@ pub struct SimplifyReport {
     pub iterations: Vec<IterationRecord>,
     /// Why it stopped.
     pub stop: StopReason,
+    /// What keeps each edge of the result from collapsing (every edge
+    /// estimated once more at the end, as the loop does: the first term
+    /// found over its bound).
+    pub binding: BindingCounts,
     /// Seconds in all.
     pub seconds: f64,
 }
@@ -458,11 +503,27 @@ pub fn simplify(
             }
         }
     }
+    report.binding = census(&mesh, &target, &lim);
     let out = finish(&mesh)?;
     report.faces_out = out.triangles().len();
     report.vertices_out = out.vertices().len();
     report.seconds = start.elapsed().as_secs_f64();
     Ok(Simplified { grid: out, report })
+}
+
+/// Every live edge's binding (estimates stop at the first term over its
+/// bound, as in the loop). Parallel; O(E · S log F).
+fn census(mesh: &HalfedgeMesh, target: &Target, lim: &Limits) -> BindingCounts {
+    let edges: Vec<u32> = mesh.edges().collect();
+    let found: Vec<Binding> = edges
+        .par_iter()
+        .map(|&e| estimate::estimate(mesh, target, e, lim, 0.5).binding)
+        .collect();
+    let mut counts = BindingCounts::default();
+    for b in found {
+        counts.add(b);
+    }
+    counts
 }
 
 /// When each vertex last changed: `moved` (position or size) and `ring`

@@ -121,9 +121,7 @@ fn propose(mesh: &HalfedgeMesh, target: &Target, v: u32, lim: &Limits) -> Option
                 mesh.positions[x as usize]
             }
         });
-        if !face_ok(old, new, [0.0; 3], lim) {
-            return None;
-        }
+        face_ok(old, new, [0.0; 3], lim).ok()?;
         let h = fv.map(|x| {
             if x == v {
                 hit.size

@@ -202,3 +202,54 @@ pub fn cylinder(r: f64, h: f64, n: usize, m: usize, rings: usize) -> Grid {
     }
     s.grid()
 }
+
+/// A thick-walled tube along z as one closed body: outer radius `r_out`,
+/// inner radius `r_in` (the bore), height `h`, `n` segments around and `m`
+/// along the height, annular caps. Normals outward from the material.
+pub fn tube(r_in: f64, r_out: f64, h: f64, n: usize, m: usize) -> Grid {
+    let mut s = Soup::default();
+    tube_into(&mut s, r_in, r_out, h, n, m);
+    s.grid()
+}
+
+/// Adds [`tube`]'s triangles to `s`.
+pub fn tube_into(s: &mut Soup, r_in: f64, r_out: f64, h: f64, n: usize, m: usize) {
+    let pt = |i: usize, z: f64, rr: f64| {
+        let a = 2.0 * std::f64::consts::PI * (i % n) as f64 / n as f64;
+        [rr * a.cos(), rr * a.sin(), z]
+    };
+    for j in 0..m {
+        let (z0, z1) = (h * j as f64 / m as f64, h * (j + 1) as f64 / m as f64);
+        for i in 0..n {
+            s.tri(pt(i, z0, r_out), pt(i + 1, z0, r_out), pt(i + 1, z1, r_out));
+            s.tri(pt(i, z0, r_out), pt(i + 1, z1, r_out), pt(i, z1, r_out));
+            s.tri(pt(i, z0, r_in), pt(i + 1, z1, r_in), pt(i + 1, z0, r_in));
+            s.tri(pt(i, z0, r_in), pt(i, z1, r_in), pt(i + 1, z1, r_in));
+        }
+    }
+    for i in 0..n {
+        let (a, b, c, d) = (
+            pt(i, h, r_in),
+            pt(i + 1, h, r_in),
+            pt(i + 1, h, r_out),
+            pt(i, h, r_out),
+        );
+        s.tri(a, c, b);
+        s.tri(a, d, c);
+        let (a, b, c, d) = (
+            pt(i, 0.0, r_in),
+            pt(i + 1, 0.0, r_in),
+            pt(i + 1, 0.0, r_out),
+            pt(i, 0.0, r_out),
+        );
+        s.tri(a, b, c);
+        s.tri(a, c, d);
+    }
+}
+
+/// Adds the triangles of `g` to `s` (to build assemblies of several bodies).
+pub fn add_grid(s: &mut Soup, g: &Grid) {
+    let o = s.v.len() as u32;
+    s.v.extend_from_slice(g.vertices());
+    s.t.extend(g.triangles().iter().map(|t| t.map(|i| i + o)));
+}
