@@ -153,9 +153,10 @@ impl Sampled {
         } else {
             0.0
         };
-        if !(a < self.de.max(c)) {
+        // NaN terms (an infinite size ratio) count as the size test.
+        if a.is_nan() || a >= self.de.max(c) {
             Binding::Size
-        } else if !(self.de < c) {
+        } else if self.de >= c {
             Binding::Distance
         } else {
             Binding::MaxDistance
