@@ -250,8 +250,8 @@ pub fn write_json(path: &Path, v: &Value) -> Result<()> {
     std::fs::write(path, text + "\n").map_err(|e| Error::io(path, e))
 }
 
-/// Runs `abgs label`: one line per edge, `a b ds dd_rel valid y` (CSV with a
-/// header), in the grid's edge order.
+/// Runs `abgs label`: one line per edge, `a b ds dd_rel de valid y` (CSV with
+/// a header), in the grid's edge order.
 pub fn label(input: &Path, output: &Path, args: &SimplifyArgs) -> Result<()> {
     let g = crate::progress::load(input)?;
     let pb = crate::progress::spinner(format!("scoring {} edges", g.topology().edges.len()));
@@ -261,7 +261,7 @@ pub fn label(input: &Path, output: &Path, args: &SimplifyArgs) -> Result<()> {
     let io = |e: std::io::Error| Error::io(output, e);
     let f = std::fs::File::create(output).map_err(io)?;
     let mut w = std::io::BufWriter::new(f);
-    writeln!(w, "a,b,ds,dd_rel,valid,y").map_err(io)?;
+    writeln!(w, "a,b,ds,dd_rel,de,valid,y").map_err(io)?;
     let num = |x: f64| {
         if x.is_nan() {
             String::new()
@@ -272,11 +272,12 @@ pub fn label(input: &Path, output: &Path, args: &SimplifyArgs) -> Result<()> {
     for s in &scores {
         writeln!(
             w,
-            "{},{},{},{},{},{:.9e}",
+            "{},{},{},{},{},{},{:.9e}",
             s.vertices[0],
             s.vertices[1],
             num(s.ds),
             num(s.dd_rel),
+            num(s.de),
             u8::from(s.valid),
             s.y
         )

@@ -608,21 +608,21 @@ fn label_writes_one_line_per_edge() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(&out).unwrap();
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some("a,b,ds,dd_rel,valid,y"));
+    assert_eq!(lines.next(), Some("a,b,ds,dd_rel,de,valid,y"));
     let g = abgs::Grid::load(&dense).unwrap();
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), g.topology().edges.len());
     let mut collapsible = 0;
     for (row, e) in rows.iter().zip(&g.topology().edges) {
         let f: Vec<&str> = row.split(',').collect();
-        assert_eq!(f.len(), 6);
+        assert_eq!(f.len(), 7);
         assert_eq!(
             [f[0].parse::<u32>().unwrap(), f[1].parse::<u32>().unwrap()],
             *e
         );
-        let y: f64 = f[5].parse().unwrap();
+        let y: f64 = f[6].parse().unwrap();
         assert!((0.0..=1.0).contains(&y));
-        if f[4] == "0" {
+        if f[5] == "0" {
             assert_eq!(y, 1.0);
             assert!(f[2].is_empty());
         } else if y < 0.5 {

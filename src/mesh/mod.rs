@@ -1,8 +1,10 @@
 //! The background grid: an immutable triangle surface with one size per vertex,
 //! its adjacency, its BVH and the report of what was found on input.
 
+pub mod feature_lines;
 pub mod features;
 pub mod halfedge;
+pub mod shape;
 pub(crate) mod stats;
 mod topology;
 mod validate;

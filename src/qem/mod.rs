@@ -260,7 +260,7 @@ pub fn decimate(input: &Grid, params: &QemParams) -> Result<Decimated> {
     let start = Instant::now();
     let features = Features::detect(input, params.feature_angle_deg);
     let (mut mesh, _) = HalfedgeMesh::from_grid(input, Some(&features));
-    crate::remesh::reference::mark_corners(&mut mesh, params.feature_angle_deg);
+    crate::mesh::feature_lines::mark_corners(&mut mesh, params.feature_angle_deg);
     let quadric = initial_quadrics(&mesh, params.boundary_weight);
     let ne = mesh.n_edges();
     let mut d = Decimator {

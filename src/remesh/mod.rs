@@ -458,7 +458,7 @@ fn issues(mesh: &HalfedgeMesh, report: &RemeshReport) -> Vec<String> {
         .faces()
         .filter(|&f| {
             let [a, bb, c] = mesh.face_vertices(f).map(|v| mesh.positions[v as usize]);
-            ops::min_angle_deg(a, bb, c) < 5.0
+            crate::mesh::shape::min_angle_deg(a, bb, c) < 5.0
         })
         .count();
     if bad > 0 {
@@ -467,7 +467,7 @@ fn issues(mesh: &HalfedgeMesh, report: &RemeshReport) -> Vec<String> {
             .filter(|&f| {
                 let vs = mesh.face_vertices(f);
                 let [a, bb, c] = vs.map(|v| mesh.positions[v as usize]);
-                ops::min_angle_deg(a, bb, c) < 5.0
+                crate::mesh::shape::min_angle_deg(a, bb, c) < 5.0
                     && vs
                         .iter()
                         .all(|&v| mesh.vertex_flags[v as usize] & V_FEATURE != 0)

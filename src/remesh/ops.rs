@@ -9,6 +9,7 @@ use crate::geometry::{closest_point_triangle, cross, dot, lerp, norm, norm2, sub
 use crate::mesh::halfedge::{
     HalfedgeMesh, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED,
 };
+use crate::mesh::shape::{self, flatness, min_angle_deg, reliable_normal, unit};
 
 /// Geometric limits of the passes.
 #[derive(Debug, Clone, Copy)]
@@ -30,54 +31,6 @@ pub struct Limits {
 #[inline]
 fn target(mesh: &HalfedgeMesh, a: u32, b: u32) -> f64 {
     0.5 * (mesh.vertex_size[a as usize] + mesh.vertex_size[b as usize])
-}
-
-/// Smallest interior angle of a triangle, in degrees (0 when degenerate).
-pub fn min_angle_deg(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    let ang = |p: [f64; 3], q: [f64; 3], r: [f64; 3]| {
-        let (u, v) = (sub(q, p), sub(r, p));
-        norm(cross(u, v)).atan2(dot(u, v))
-    };
-    ang(a, b, c)
-        .min(ang(b, c, a))
-        .min(ang(c, a, b))
-        .to_degrees()
-}
-
-fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
-    let l = norm(n);
-    (l > 0.0 && l.is_finite()).then(|| [n[0] / l, n[1] / l, n[2] / l])
-}
-
-/// Shape measure of triangle (a, b, c): `|ab × ac| / (longest side)²`, twice
-/// the height over the longest side divided by it (0 when degenerate, √3/2
-/// when equilateral).
-pub fn flatness(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    let l = norm(cross(sub(b, a), sub(c, a)));
-    let m = norm2(sub(b, a)).max(norm2(sub(c, b))).max(norm2(sub(a, c)));
-    if m > 0.0 && l.is_finite() {
-        l / m
-    } else {
-        0.0
-    }
-}
-
-/// A move of a face from `old` corners to `new` corners keeps it sound: it
-/// does not become a sliver (flatness below 0.01) unless it was one, and then
-/// it does not get flatter.
-pub fn keeps_shape(old: [[f64; 3]; 3], new: [[f64; 3]; 3]) -> bool {
-    let q = flatness(new[0], new[1], new[2]);
-    q > 0.0 && q >= flatness(old[0], old[1], old[2]).min(0.01)
-}
-
-/// Unit normal of triangle (a, b, c) when its direction is trustworthy: the
-/// height over the longest side is at least 1 % of that side (no angle below
-/// about 0.6°). Slivers and caps have noise for a normal and give `None`.
-pub fn reliable_normal(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Option<[f64; 3]> {
-    let n = cross(sub(b, a), sub(c, a));
-    let l = norm(n);
-    let m = norm2(sub(b, a)).max(norm2(sub(c, b))).max(norm2(sub(a, c)));
-    (l.is_finite() && l > 0.01 * m).then(|| [n[0] / l, n[1] / l, n[2] / l])
 }
 
 /// Splits every unlocked edge longer than 4/3 of its target at its midpoint,
@@ -302,38 +255,10 @@ fn ideal_valence(mesh: &HalfedgeMesh, v: u32) -> Option<i64> {
     }
 }
 
-/// Is flipping edge `e` geometrically sound: both new faces non-degenerate,
-/// their normals within the turn limit of the old ones, no new crease, and
-/// the smallest angle not made worse than `min(old, floor_deg)`?
+/// Is flipping edge `e` geometrically sound under these limits (see
+/// [`shape::flip_sound`])?
 pub fn flip_geometry_ok(mesh: &HalfedgeMesh, e: u32, lim: &Limits, floor_deg: f64) -> bool {
-    let [a, b] = mesh.edge_vertices(e);
-    let [c, d] = mesh.flip_apexes(e);
-    let [pa, pb, pc, pd] = [a, b, c, d].map(|x| mesh.positions[x as usize]);
-    let n = |x: [f64; 3], y: [f64; 3], z: [f64; 3]| unit(cross(sub(y, x), sub(z, x)));
-    let (Some(o1), Some(o2)) = (reliable_normal(pa, pb, pc), reliable_normal(pb, pa, pd)) else {
-        // A degenerate old face: a flatter-free new pair that agrees with itself.
-        let q_old = flatness(pa, pb, pc).min(flatness(pb, pa, pd));
-        let q_new = flatness(pa, pd, pc).min(flatness(pd, pb, pc));
-        return q_new > q_old
-            && match (n(pa, pd, pc), n(pd, pb, pc)) {
-                (Some(n1), Some(n2)) => dot(n1, n2) >= lim.cos_turn,
-                _ => false,
-            };
-    };
-    let (Some(n1), Some(n2)) = (n(pa, pd, pc), n(pd, pb, pc)) else {
-        return false;
-    };
-    for nn in [n1, n2] {
-        if dot(nn, o1) < lim.cos_turn || dot(nn, o2) < lim.cos_turn {
-            return false;
-        }
-    }
-    if dot(n1, n2) < dot(o1, o2).min(lim.cos_crease) {
-        return false;
-    }
-    let q_old = min_angle_deg(pa, pb, pc).min(min_angle_deg(pb, pa, pd));
-    let q_new = min_angle_deg(pa, pd, pc).min(min_angle_deg(pd, pb, pc));
-    q_new >= q_old.min(floor_deg)
+    shape::flip_sound(mesh, e, lim.cos_turn, lim.cos_crease, floor_deg)
 }
 
 /// Edge `e` may be flipped (live, not a feature or locked, topologically

@@ -12,10 +12,10 @@
 //! A move that would turn a face normal by more than the limit is halved (up
 //! to three times), else the vertex is only projected.
 
-use super::ops::{keeps_shape, reliable_normal};
 use super::reference::{Projected, Reference};
 use crate::geometry::{add, cross, dot, norm, scale, sub};
 use crate::mesh::halfedge::{HalfedgeMesh, E_FEATURE, NONE, V_CORNER, V_FEATURE, V_LOCKED};
+use crate::mesh::shape::{keeps_shape, reliable_normal};
 use rayon::prelude::*;
 
 /// A projection onto the vertex's own part of the reference.

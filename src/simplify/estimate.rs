@@ -10,7 +10,8 @@ use crate::geometry::{add, closest_point_triangle, cross, dot, lerp, norm, scale
 use crate::mesh::halfedge::{
     HalfedgeMesh, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED,
 };
-use crate::remesh::ops::reliable_normal;
+pub use crate::mesh::shape::max_angle_deg;
+use crate::mesh::shape::{reliable_normal, unit};
 
 /// The thresholds of one estimation.
 #[derive(Debug, Clone, Copy)]
@@ -252,17 +253,6 @@ pub fn sample_fan(
         }
     }
     out
-}
-
-fn unit(n: [f64; 3]) -> Option<[f64; 3]> {
-    let l = norm(n);
-    (l > 0.0 && l.is_finite()).then(|| scale(n, 1.0 / l))
-}
-
-/// Largest interior angle of a triangle, degrees.
-pub fn max_angle_deg(p: [[f64; 3]; 3]) -> f64 {
-    let t = crate::geometry::triangle_angles_deg(p[0], p[1], p[2]);
-    t[0].max(t[1]).max(t[2])
 }
 
 /// Checks a face that moves from corners `old` to `new`: non-degenerate, its

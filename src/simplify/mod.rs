@@ -36,9 +36,9 @@ pub use estimate::{Binding, Estimate, Limits};
 pub use target::{Hit, Target};
 
 use crate::error::{Error, Result};
+use crate::mesh::feature_lines::{feature_lines, FeatureLines};
 use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED, NONE, V_CORNER};
 use crate::mesh::{BuildOptions, Features, Grid};
-use crate::remesh::reference::{feature_lines, FeatureLines};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -375,7 +375,7 @@ pub fn simplify(
     let (mut mesh, parts) = setup(grid, params)?;
     let target = parts.target(grid);
     let lim = params.limits();
-    let flip_lim = repair::flip_limits(&lim, params.feature_angle_deg);
+    let cos_crease = repair::crease_limit(params.feature_angle_deg);
     let mut report = SimplifyReport {
         faces_in: grid.triangles().len(),
         vertices_in: grid.vertices().len(),
@@ -481,7 +481,7 @@ pub fn simplify(
             for &v in &moved {
                 stamps.moved[v as usize] = it;
             }
-            let flipped = repair::flip_around(&mut mesh, &target, &kept, &lim, &flip_lim);
+            let flipped = repair::flip_around(&mut mesh, &target, &kept, &lim, cos_crease);
             rec.flips = flipped.len() / 4;
             for v in flipped {
                 stamps.ring[v as usize] = it;

@@ -13,7 +13,7 @@ use crate::geometry::{add, closest_point_triangle, cross, dot, lerp, norm, scale
 use crate::mesh::halfedge::{
     HalfedgeMesh, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED,
 };
-use crate::remesh::ops::{flip_geometry_ok, min_angle_deg, Limits as FlipLimits};
+use crate::mesh::shape::{flip_sound, min_angle_deg};
 use rayon::prelude::*;
 
 /// A proposed move of one vertex.
@@ -185,14 +185,14 @@ pub fn relax(mesh: &mut HalfedgeMesh, target: &Target, verts: &[u32], lim: &Limi
 
 /// Flips the non-feature edges around `verts` where that lowers the largest
 /// angle of the two faces by more than 1°, keeps normals and creases
-/// (as the remesher's flips) and passes the sampled size and distance check.
+/// (creases up to `cos_crease`, see [`crease_limit`]) and passes the sampled size and distance check.
 /// Sequential, in the order given. Returns the vertices whose rings changed.
 pub fn flip_around(
     mesh: &mut HalfedgeMesh,
     target: &Target,
     verts: &[u32],
     lim: &Limits,
-    flip_lim: &FlipLimits,
+    cos_crease: f64,
 ) -> Vec<u32> {
     let mut edges = Vec::new();
     for &v in verts {
@@ -225,7 +225,7 @@ pub fn flip_around(
         let [pa, pb, pc, pd] = [a, b, c, d].map(|x| mesh.positions[x as usize]);
         let old = max_angle_deg([pa, pb, pc]).max(max_angle_deg([pb, pa, pd]));
         let new = max_angle_deg([pa, pd, pc]).max(max_angle_deg([pd, pb, pc]));
-        if new >= old - 1.0 || !flip_geometry_ok(mesh, e, flip_lim, 0.0) {
+        if new >= old - 1.0 || !flip_sound(mesh, e, lim.cos_turn, cos_crease, 0.0) {
             continue;
         }
         let [sa, sb, sc, sd] = [a, b, c, d].map(|x| mesh.vertex_size[x as usize]);
@@ -253,13 +253,8 @@ pub fn flip_around(
     touched
 }
 
-/// The remesher's flip limits for the simplifier's thresholds: the same
-/// normal turn, creases capped at min(feature angle, 20°).
-pub fn flip_limits(lim: &Limits, feature_angle_deg: f64) -> FlipLimits {
-    FlipLimits {
-        cos_turn: lim.cos_turn,
-        sliver_deg: 0.0,
-        fidelity: f64::INFINITY,
-        cos_crease: feature_angle_deg.min(20.0).to_radians().cos(),
-    }
+/// Cosine of the largest crease a repair flip may create: min(feature angle,
+/// 20°), as the remesher's flips.
+pub fn crease_limit(feature_angle_deg: f64) -> f64 {
+    feature_angle_deg.min(20.0).to_radians().cos()
 }

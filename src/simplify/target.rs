@@ -7,8 +7,8 @@
 use super::envelope::Envelope;
 use super::estimate::Limits;
 use crate::geometry::lerp;
+use crate::mesh::feature_lines::FeatureLines;
 use crate::mesh::Grid;
-use crate::remesh::reference::FeatureLines;
 
 /// Where a point lands on the target.
 #[derive(Debug, Clone, Copy)]
