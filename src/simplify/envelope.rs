@@ -43,9 +43,11 @@
 //!   sides together move at most `c/2`: a query point may still lie `c/4` off
 //!   its sheet (the mesher's own chord error) and land on the right one. The
 //!   clearance is measured on the target as the proximity sizes measure gaps
-//!   ([`crate::sizing::proximity`]): rays along ±n to the nearest face that
-//!   faces back, contacts (closer than the contact gap) excluded, since there
-//!   the two bodies' sizes agree by construction.
+//!   ([`crate::sizing::proximity::clearances`]): rays along ±n to the nearest
+//!   face that faces back or belongs to another body (a body nested inside
+//!   another has a parallel sheet facing the same way), contacts (closer than
+//!   the contact gap) excluded, since there the two bodies' sizes agree by
+//!   construction.
 //!
 //! Where proximity sizing is on, `h ≤ c / n_gap`, so with `n_gap` = 3 the
 //! clearance term is at least `0.75·h` and the misprojection term (`h/2`)
@@ -65,7 +67,7 @@
 //! per patch normal per vertex, O(V log F), parallel, rays no longer than the
 //! distance at which the clearance could bind). Each allowance is then O(1).
 
-use crate::geometry::{cross, norm, norm2, sub};
+use crate::geometry::{cross, lerp, norm, norm2, sub};
 use crate::mesh::{Features, Grid};
 use crate::sizing::normals::PatchNormals;
 use crate::sizing::proximity;
@@ -162,12 +164,38 @@ impl Envelope {
                 })
                 .collect();
             let contact = grid.bbox().diagonal() * CONTACT_FRACTION;
-            let c = proximity::gaps_within(grid, &normals, contact, &limit);
+            let c = proximity::clearances(grid, &normals, contact, &limit);
             t.par_iter()
-                .map(|tri| {
-                    tri.iter()
+                .enumerate()
+                .map(|(f, tri)| {
+                    let corners = tri
+                        .iter()
                         .map(|&i| c[i as usize])
-                        .fold(f64::INFINITY, f64::min)
+                        .fold(f64::INFINITY, f64::min);
+                    if topo.body_count < 2 {
+                        return corners;
+                    }
+                    // Another body can come closer inside the triangle than
+                    // at its corners (its edge beside a large face): its
+                    // distance at the centroid and the edge midpoints too.
+                    let body = topo.face_body[f];
+                    let p = tri.map(|i| v[i as usize]);
+                    let at = [
+                        lerp(lerp(p[0], p[1], 0.5), p[2], 1.0 / 3.0),
+                        lerp(p[0], p[1], 0.5),
+                        lerp(p[1], p[2], 0.5),
+                        lerp(p[2], p[0], 0.5),
+                    ];
+                    let limit = tri.iter().map(|&i| limit[i as usize]).fold(0.0, f64::max);
+                    at.iter().fold(corners, |m, &q| {
+                        grid.bvh()
+                            .closest_filtered_within(q, m.min(limit), |o| {
+                                topo.face_body[o as usize] != body
+                            })
+                            .map(|h| h.closest.dist2.sqrt())
+                            .filter(|&d| d >= contact)
+                            .map_or(m, |d| m.min(d))
+                    })
                 })
                 .collect()
         } else {

@@ -20,18 +20,22 @@ pub(crate) const FACING_BACK: f64 = -0.2;
 /// Smallest gap per vertex (`+inf` where no opposite wall lies within `max_gap`).
 /// O(V log F), parallel over vertices.
 pub fn gaps(grid: &Grid, normals: &PatchNormals, contact_gap: f64, max_gap: f64) -> Vec<f64> {
-    gaps_with(grid, normals, contact_gap, |_| max_gap)
+    gaps_with(grid, normals, contact_gap, |_| max_gap, false)
 }
 
-/// [`gaps`] with a limit per vertex (`limit[v]`: rays from `v` stop there).
-/// O(V log F), parallel over vertices.
-pub fn gaps_within(
+/// Clearance per vertex: [`gaps`] with a limit per vertex (`limit[v]`: rays
+/// from `v` stop there), where a face of another body counts whichever way
+/// it faces (two bodies' parallel sheets, one inside the other, are still two
+/// sheets a query can confuse), and so does the nearest point of another
+/// body in any direction (not closer than the contact gap). O(V log F),
+/// parallel over vertices.
+pub fn clearances(
     grid: &Grid,
     normals: &PatchNormals,
     contact_gap: f64,
     limit: &[f64],
 ) -> Vec<f64> {
-    gaps_with(grid, normals, contact_gap, |v| limit[v])
+    gaps_with(grid, normals, contact_gap, |v| limit[v], true)
 }
 
 fn gaps_with(
@@ -39,6 +43,7 @@ fn gaps_with(
     normals: &PatchNormals,
     contact_gap: f64,
     max_gap: impl Fn(usize) -> f64 + Sync,
+    other_bodies: bool,
 ) -> Vec<f64> {
     let v = grid.vertices();
     let topo = grid.topology();
@@ -47,6 +52,7 @@ fn gaps_with(
         .into_par_iter()
         .map(|vi| {
             let own = topo.faces_of_vertex(vi);
+            let body = own.first().map(|&f| topo.face_body[f as usize]);
             let max_gap = max_gap(vi);
             let mut best = f64::INFINITY;
             let range = normals.range(vi);
@@ -71,10 +77,24 @@ fn gaps_with(
                     let limit = best.min(max_gap);
                     let hit = bvh.first_hit(v[vi], dir, contact_gap, limit, |tri, _| {
                         own.binary_search(&tri).is_err()
-                            && dot(n, normals.face_normal[tri as usize]) < FACING_BACK
+                            && (dot(n, normals.face_normal[tri as usize]) < FACING_BACK
+                                || (other_bodies && Some(topo.face_body[tri as usize]) != body))
                     });
                     if let Some((_, t)) = hit {
                         best = best.min(t);
+                    }
+                }
+            }
+            // Another body beside the vertex, in any direction (an edge or a
+            // corner of it near a face of this one is missed by the rays).
+            if let (true, Some(body)) = (other_bodies, body) {
+                let near = bvh.closest_filtered_within(v[vi], best.min(max_gap), |t| {
+                    topo.face_body[t as usize] != body
+                });
+                if let Some(h) = near {
+                    let d = h.closest.dist2.sqrt();
+                    if d >= contact_gap {
+                        best = best.min(d);
                     }
                 }
             }
