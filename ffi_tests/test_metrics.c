@@ -56,8 +56,9 @@ int main(void) {
     CHECK(e.vertices_reference == NVF && e.vertices_candidate == NVF);
     CHECK(e.reduction == 0.0);
     CHECK(near(e.size_deviation_mean, 1.0, 1e-14) && near(e.size_deviation_max, 1.0, 1e-14));
-    CHECK(near(e.size_deviation_p95, 1.0, 1e-14));
+    CHECK(near(e.size_deviation_p95, 1.0, 1e-14) && near(e.size_deviation_p99, 1.0, 1e-14));
     CHECK(e.size_deviation_samples == 20000);
+    CHECK(e.wrong_sheet == 0.0);
     CHECK(e.hausdorff < 1e-15 && e.hausdorff_relative < 1e-15);
     CHECK(near(e.diagonal, sqrt(2.0), 1e-15));
     CHECK(fabs(e.element_count_change) < 1e-12);
@@ -65,6 +66,8 @@ int main(void) {
        the degree-5 rule on 1/h² over 8 columns is within 1e-6 of it. */
     double expected = 4.0 / sqrt(3.0) * 50.0;
     CHECK(near(e.element_count_reference, expected, 1e-6 * expected));
+    CHECK(near(e.elements_per_cell, e.element_count_candidate / NTF, 1e-15 * expected));
+    CHECK(e.elements_per_cell == e.elements_per_cell_reference);
     if (!near(e.element_count_reference, expected, 1e-6 * expected))
         fprintf(stderr, "element count %.12g, expected %.12g\n", e.element_count_reference, expected);
     CHECK(near(e.angles_reference.min, 45.0, 1e-9) && near(e.angles_reference.max, 90.0, 1e-9));
@@ -77,6 +80,9 @@ int main(void) {
     CHECK(near(e.size_deviation_max, 1.0, 1e-12) && near(e.size_deviation_mean, 1.0, 1e-12));
     CHECK(e.hausdorff < 1e-12);
     CHECK(near(e.element_count_candidate, expected, 1e-6 * expected));
+    /* Fewer cells for the same elements. */
+    CHECK(near(e.elements_per_cell, e.element_count_candidate / NTC, 1e-12 * expected));
+    CHECK(e.elements_per_cell > e.elements_per_cell_reference);
     CHECK(fabs(e.element_count_change) < 1e-9);
 
     /* Doubled sizes: the ratio is 2 everywhere, a quarter of the elements. */

@@ -252,3 +252,56 @@ fn morton_order_is_a_coherent_permutation() {
     );
     assert_eq!(morton_order(&[[1.0; 3]; 3]), vec![0, 1, 2]);
 }
+
+/// `g` with every triangle's orientation reversed.
+fn flipped(g: &Grid) -> Grid {
+    let t = g.triangles().iter().map(|t| [t[0], t[2], t[1]]).collect();
+    let opts = BuildOptions {
+        weld_relative_tolerance: None,
+        orient: false,
+    };
+    Grid::from_arrays(
+        g.vertices().to_vec(),
+        t,
+        g.sizes().map(|s| s.to_vec()),
+        &opts,
+    )
+    .unwrap()
+}
+
+#[test]
+fn wrong_sheet_counts_faces_turned_away_and_other_bodies() {
+    let g = plate(20, bumpy, Some(&field));
+    assert_eq!(size_deviation(&g, &g, 5_000, 1).unwrap().wrong_sheet, 0.0);
+    // Every query lands on a face turned away.
+    assert_eq!(
+        size_deviation(&g, &flipped(&g), 5_000, 1)
+            .unwrap()
+            .wrong_sheet,
+        1.0
+    );
+    // Two parallel plates 0.2 apart (two bodies); the candidate keeps only the
+    // upper one twice over (its lower body lifted onto the upper): the lower
+    // plate's samples land on the other body, the upper's do not.
+    let (v, t) = crate::test_shapes::unit_square(10, flat);
+    let two = |lift: f64| {
+        let mut vv = v.clone();
+        vv.extend(v.iter().map(|p| [p[0], p[1], p[2] + 0.2]));
+        let n = v.len() as u32;
+        let mut tt = t.clone();
+        tt.extend(t.iter().map(|t| t.map(|i| i + n)));
+        for p in vv.iter_mut().take(v.len()) {
+            p[2] += lift;
+        }
+        let h = vec![0.1; vv.len()];
+        Grid::from_arrays(vv, tt, Some(h), &BuildOptions::default()).unwrap()
+    };
+    let reference = two(0.0);
+    assert_eq!(reference.topology().body_count, 2);
+    let w = size_deviation(&reference, &two(0.3), 20_000, 1)
+        .unwrap()
+        .wrong_sheet;
+    // The lower plate (half the area) moved to z = 0.3: its samples at z = 0
+    // are now closer to the upper plate (0.2) than to their own (0.3).
+    assert!((w - 0.5).abs() < 0.02, "{w}");
+}
