@@ -49,7 +49,9 @@ per 2*pi from curvature; if the triangle count falls outside [2000, 60000] the
 part is re-meshed with the sizes scaled (recorded in ``mesh``).
 
 Determinism: part k is built from ``random.Random(seed + k)`` only, so it does
-not depend on the other parts, on ``--count`` or on ``--jobs``. If an attempt
+not depend on the other parts, on ``--count`` or on ``--jobs``. (Hence seed S
+part k+1 is seed S+1 part k: give disjoint sets, e.g. training and validation,
+seeds further apart than their counts.) If an attempt
 fails (an OCC boolean, gmsh meshing, or STL validation: empty, triangle count
 out of range, open surface, degenerate triangles) the part is retried with the
 next sub-seed, ``random.Random(f"{seed + k}.{attempt}")``; the failures are
@@ -58,8 +60,20 @@ compute fall back to the unfilleted shape (recorded in the parameters, e.g.
 ``"fillet": "failed"``) and are not failures. The same seed and count give the
 same STL bytes, the same parts.json and the same STEP bytes (the timestamp in
 the STEP header is fixed). Each attempt runs in its own process with its own
-gmsh session (initialize / finalize), at most ``--jobs`` at a time, and is
-killed after ``--timeout`` seconds, so a hanging OCC call cannot stall the run.
+gmsh session (initialize / finalize), at most ``--jobs`` at a time (a small
+process pool: a hung attempt can be killed, which a multiprocessing.Pool
+cannot do), and is killed after ``--timeout`` seconds, so a hanging OCC or
+meshing call cannot stall the run; only such a timeout depends on the machine,
+and the default is far above the usual seconds per part.
+
+Meshing: ``Mesh.MeshSizeExtendFromBoundary`` is 1 (sizes grade smoothly into
+the faces) unless the 1-D mesh predicts an explosion (small fillets bounding
+large flat faces would fill them with fillet-sized triangles); then it is 0 and
+the faces are meshed at MeshSizeMax, graded only near their fine boundaries.
+Each record gives the settings used (``mesh``), the STL's welded vertex count
+and its connected components counted as abgs does (faces joined across edges
+with exactly two faces). Every STL is closed body by body: each edge has an
+even number of faces.
 """
 
 from __future__ import annotations
@@ -189,6 +203,64 @@ def vertical(c: int, tol: float) -> bool:
     return (b[3] - b[0]) < tol and (b[4] - b[1]) < tol and (b[5] - b[2]) > tol
 
 
+@dataclass
+class Circle:
+    x: float
+    y: float
+    r: float
+
+
+def place_circles(
+    rng: random.Random,
+    rect: tuple[float, float, float, float],
+    radii: list[float],
+    margin: float,
+    taken: list[Circle] | None = None,
+    tries: int = 200,
+) -> list[Circle]:
+    """Rejection-sample non-overlapping discs inside rect (x0, y0, x1, y1).
+
+    Discs keep `margin` to the rectangle's sides and to each other (and to the
+    `taken` discs); a radius that does not fit is skipped.
+    """
+    x0, y0, x1, y1 = rect
+    placed: list[Circle] = []
+    others = list(taken or [])
+    for r in radii:
+        lo_x, hi_x = x0 + r + margin, x1 - r - margin
+        lo_y, hi_y = y0 + r + margin, y1 - r - margin
+        if lo_x >= hi_x or lo_y >= hi_y:
+            continue
+        for _ in range(tries):
+            c = Circle(rng.uniform(lo_x, hi_x), rng.uniform(lo_y, hi_y), r)
+            if all(
+                math.hypot(c.x - o.x, c.y - o.y) > c.r + o.r + margin for o in others
+            ):
+                placed.append(c)
+                others.append(c)
+                break
+    return placed
+
+
+def full_circles_at(
+    body: list[DimTag], z: float, centres: list[Circle], tol: float
+) -> list[int]:
+    """Closed circles of `body` in the plane z whose centre is one of
+    `centres` (the hole or boss axes): partial arcs (rounded corners, slot
+    ends) are left out, since blending them alone breaks tangent chains."""
+    out = []
+    for c in curves_of(body):
+        if ctype(c) != "Circle" or not at_z(c, z, tol):
+            continue
+        b = cbox(c)
+        cx, cy = (b[0] + b[3]) / 2.0, (b[1] + b[4]) / 2.0
+        if abs((b[3] - b[0]) - (b[4] - b[1])) < tol and any(
+            abs(cx - k.x) < tol and abs(cy - k.y) < tol for k in centres
+        ):
+            out.append(c)
+    return out
+
+
 def try_fillet(
     body: list[DimTag], curves: list[int], radius: float, log: Params, key: str
 ) -> list[DimTag]:
@@ -255,45 +327,6 @@ def _try_blend(
     o.synchronize()
     log[key] = "ok"
     return new
-
-
-@dataclass
-class Circle:
-    x: float
-    y: float
-    r: float
-
-
-def place_circles(
-    rng: random.Random,
-    rect: tuple[float, float, float, float],
-    radii: list[float],
-    margin: float,
-    taken: list[Circle] | None = None,
-    tries: int = 200,
-) -> list[Circle]:
-    """Rejection-sample non-overlapping discs inside rect (x0, y0, x1, y1).
-
-    Discs keep `margin` to the rectangle's sides and to each other (and to the
-    `taken` discs); a radius that does not fit is skipped.
-    """
-    x0, y0, x1, y1 = rect
-    placed: list[Circle] = []
-    others = list(taken or [])
-    for r in radii:
-        lo_x, hi_x = x0 + r + margin, x1 - r - margin
-        lo_y, hi_y = y0 + r + margin, y1 - r - margin
-        if lo_x >= hi_x or lo_y >= hi_y:
-            continue
-        for _ in range(tries):
-            c = Circle(rng.uniform(lo_x, hi_x), rng.uniform(lo_y, hi_y), r)
-            if all(
-                math.hypot(c.x - o.x, c.y - o.y) > c.r + o.r + margin for o in others
-            ):
-                placed.append(c)
-                others.append(c)
-                break
-    return placed
 
 
 def slot_tool(
@@ -379,7 +412,7 @@ def family_plate_holes(rng: random.Random, L: float) -> Params:
     body = cut(body, tools)
     if rng.random() < 0.3:  # chamfer the top edges of the holes
         tol = 1e-3 * L
-        edges = [c for c in curves_of(body) if ctype(c) == "Circle" and at_z(c, t, tol)]
+        edges = full_circles_at(body, t, holes, tol)
         r_min = min([h.r for h in holes] or [t])
         body = try_chamfer(body, edges, rng.uniform(0.1, 0.3) * min(t, r_min), p, "hole_chamfer")
     return p
@@ -465,14 +498,11 @@ def family_bosses(rng: random.Random, L: float) -> Params:
     r_min = min(s.r for s in spots)
     h_min = min(x["h"] for x in p["bosses"])
     if rng.random() < 0.5:
-        edges = [e for e in curves_of(body) if ctype(e) == "Circle" and at_z(e, t, tol)]
+        edges = full_circles_at(body, t, spots, tol)
         size = rng.uniform(0.1, 0.35) * min(r_min, h_min, t)
         body = try_fillet(body, edges, size, p, "root_fillet")
     if rng.random() < 0.4 and tops:
-        edges = [
-            e for e in curves_of(body)
-            if ctype(e) == "Circle" and any(at_z(e, z, tol) for z in tops)
-        ]
+        edges = sorted({e for z in set(tops) for e in full_circles_at(body, z, spots, tol)})
         size = rng.uniform(0.05, 0.2) * min(0.35 * r_min, h_min)
         body = try_chamfer(body, edges, size, p, "top_chamfer")
     return p
@@ -552,9 +582,11 @@ def family_thin_gaps(rng: random.Random, L: float) -> Params:
         inner = [box(w, w, w, a - 2 * w, b - 2 * w, c)]
         if rng.random() < 0.5:
             r = rng.uniform(0.05, 0.2) * b
-            outer = try_fillet(outer, [e for e in curves_of(outer) if vertical(e, tol)], r, p, "outer_fillet")
+            edges = [e for e in curves_of(outer) if vertical(e, tol)]
+            outer = try_fillet(outer, edges, r, p, "outer_fillet")
             if p["outer_fillet"] == "ok" and r > 1.5 * w:
-                inner = try_fillet(inner, [e for e in curves_of(inner) if vertical(e, tol)], r - w, p, "inner_fillet")
+                edges = [e for e in curves_of(inner) if vertical(e, tol)]
+                inner = try_fillet(inner, edges, r - w, p, "inner_fillet")
         cut(outer, inner)
     elif variant == "tube":
         r = rng.uniform(0.1, 0.4) * L
@@ -614,8 +646,9 @@ def family_assembly(rng: random.Random, L: float) -> Params:
         cyl(xc, -stick, zc, 0, ly + 2 * stick, 0, r)  # the shaft, same radius
         extras = ["collar_front", "collar_back", "base"]
         rng.shuffle(extras)
-        ro, tc = rng.uniform(1.4, 2.0) * r, rng.uniform(0.02, 0.08) * L
-        tc = min(tc, 0.8 * stick)
+        # collars stay above the base plate (z >= 0): ro <= 0.95 zc (> 1.5 r)
+        ro = min(rng.uniform(1.4, 2.0) * r, 0.95 * min(xc, zc))
+        tc = min(rng.uniform(0.02, 0.08) * L, 0.8 * stick)
         for e in extras[: n - 2]:
             if e == "collar_front":
                 cut([cyl(xc, -tc, zc, 0, tc, 0, ro)], [cyl(xc, -2 * tc, zc, 0, 4 * tc, 0, r)])
@@ -624,7 +657,8 @@ def family_assembly(rng: random.Random, L: float) -> Params:
             else:
                 m = rng.uniform(0.1, 0.3) * L
                 box(-m, -m, -0.08 * L, wx + 2 * m, ly + 2 * m, 0.08 * L)
-        p.update(housing=[wx, ly, hz], r=r, shaft_out=stick, parts=["housing", "shaft"] + extras[: n - 2])
+        p.update(housing=[wx, ly, hz], r=r, shaft_out=stick)
+        p["parts"] = ["housing", "shaft"] + extras[: n - 2]
     elif variant == "stacked_plates":
         pinned = n >= 3 and rng.random() < 0.5
         plates = n - 1 if pinned else n
@@ -1045,7 +1079,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, default=1, help="parallel processes (default 1)")
     ap.add_argument(
         "--timeout", type=float, default=DEFAULT_TIMEOUT_S,
-        help=f"seconds per attempt before it is killed and retried (default {DEFAULT_TIMEOUT_S:.0f})",
+        help="seconds per attempt before it is killed and retried "
+        f"(default {DEFAULT_TIMEOUT_S:.0f})",
     )
     ap.add_argument(
         "--max-attempts", type=int, default=DEFAULT_MAX_ATTEMPTS,
