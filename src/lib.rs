@@ -44,6 +44,7 @@
 
 pub mod error;
 pub mod ffi;
+pub mod gcn;
 pub mod geometry;
 pub mod io;
 pub mod mesh;

@@ -1,11 +1,13 @@
 //! `abgs`: command-line front end of the abgs library.
 //!
 //! Subcommands: `info`, `convert`, `query`, `bench-query`, `size`,
-//! `check-gradation`, `grid`, `eval`. Run `abgs --help`.
+//! `check-gradation`, `grid`, `eval`, `simplify`, `label`, `dataset`, `run`.
+//! Run `abgs --help`.
 
 #![allow(clippy::needless_range_loop)]
 
 mod bench;
+mod dataset;
 mod eval;
 mod grid;
 mod info;
@@ -160,6 +162,17 @@ enum Command {
         #[command(flatten)]
         args: simplify::SimplifyArgs,
     },
+    /// Training graphs for GCN-ABGS along a whole LBO-ABGS run of a sized grid: model
+    /// inputs and the exact estimate's targets (Δs−1, Δd/h_loc) per edge, one safetensors file.
+    Dataset {
+        /// Grid with sizes.
+        input: PathBuf,
+        /// Output file (.safetensors).
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        args: dataset::DatasetArgs,
+    },
     /// The whole pipeline: dense grid -> sizes -> LBO-ABGS -> evaluation, writing
     /// DIR/dense.vtk, DIR/simplified.vtk, DIR/report.json, DIR/preview.png and
     /// DIR/convergence.png.
@@ -212,6 +225,11 @@ fn main() -> ExitCode {
             args,
         } => simplify::label(&input, &output, &args),
         Command::Run { input, args } => run::run(&input, &args),
+        Command::Dataset {
+            input,
+            output,
+            args,
+        } => dataset::run(&input, &output, &args),
         Command::Grid {
             input,
             output,

@@ -2,7 +2,7 @@
 //! simplification → evaluation, with a report and two pictures.
 
 use crate::render::{line_chart_png, preview_png, Panel, Series};
-use crate::simplify::{iterations_json, params_json, report_json, run_lbo, write_json, LboArgs};
+use crate::simplify::{iterations_json, params_json, report_json, run_abgs, write_json, LboArgs};
 use abgs::metrics::{evaluate, EvalParams};
 use abgs::qem::{decimate, QemParams};
 use abgs::remesh::{remesh, RemeshParams, TargetLength};
@@ -33,6 +33,9 @@ pub struct RunArgs {
     /// Gradation ratio β.
     #[arg(long, default_value_t = 1.2)]
     pub beta: f64,
+    /// Simplification method: lbo (LBO-ABGS) or gcn (GCN-ABGS, the embedded model).
+    #[arg(long, default_value = "lbo", value_parser = ["lbo", "gcn"])]
+    pub method: String,
     /// Simplification thresholds.
     #[command(flatten)]
     pub lbo: LboArgs,
@@ -88,9 +91,12 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
     };
     let fields = stage("sizes", &mut times, || sizing::compute(&dense, &sp))?;
     dense.set_sizes(fields.h.clone())?;
-    let params = a.lbo.params(a.feature_angle, a.beta, true);
+    let mut params = a.lbo.params(a.feature_angle, a.beta, true);
+    if a.method == "gcn" {
+        params.method = abgs::simplify::Method::Gcn;
+    }
     let t = Instant::now();
-    let simplified = run_lbo(&dense, &params)?;
+    let simplified = run_abgs(&dense, &params, a.lbo.model.as_deref())?;
     times.push(("simplify".into(), t.elapsed().as_secs_f64()));
     eprintln!(
         "simplify: {:.2} s ({} -> {} faces, {} iterations)",

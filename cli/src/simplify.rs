@@ -2,8 +2,10 @@
 //! scores, the learned simplifier's training labels).
 
 use abgs::qem::{decimate, QemParams};
+use abgs::gcn::{Learned, Model};
 use abgs::simplify::{
-    edge_scores, simplify, IterationRecord, Simplified, SimplifyParams, StopReason,
+    edge_scores, simplify, simplify_with, IterationRecord, Method as LibMethod, Simplified,
+    SimplifyParams, StopReason,
 };
 use abgs::{Error, Grid, Result};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -16,6 +18,9 @@ use std::path::{Path, PathBuf};
 pub enum Method {
     /// LBO-ABGS: sizing-aware edge collapses, each estimated exactly.
     Lbo,
+    /// GCN-ABGS: the same loop with the embedded graph network's predictions
+    /// in place of the exact estimates (--verify checks its choices exactly).
+    Gcn,
     /// Plain quadric-error decimation to `--target-faces` (the baseline), sizes re-projected.
     Qem,
 }
@@ -50,6 +55,15 @@ pub struct LboArgs {
     /// Largest turn of a face normal per collapse, move or flip, degrees.
     #[arg(long, default_value_t = SimplifyParams::default().max_normal_turn_deg)]
     pub max_normal_turn: f64,
+    /// GCN-ABGS: edges whose predicted score is at or above this are not tried (T_score).
+    #[arg(long, default_value_t = SimplifyParams::default().t_score)]
+    pub t_score: f64,
+    /// GCN-ABGS: check the model's choices with the exact estimate and drop those that fail.
+    #[arg(long)]
+    pub verify: bool,
+    /// GCN-ABGS: an ONNX model file in place of the embedded one (same inputs and output).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
 }
 
 impl LboArgs {
@@ -72,6 +86,8 @@ impl LboArgs {
             max_normal_turn_deg: self.max_normal_turn,
             feature_angle_deg,
             repair,
+            t_score: self.t_score,
+            verify: self.verify,
             ..Default::default()
         }
     }
@@ -105,7 +121,8 @@ impl SimplifyArgs {
 /// Every parameter as JSON.
 pub fn params_json(p: &SimplifyParams) -> Value {
     json!({
-        "method": "lbo",
+        "method": match p.method { LibMethod::Lbo => "lbo", LibMethod::Gcn => "gcn" },
+        "t_score": p.t_score, "verify": p.verify,
         "fraction": p.fraction, "pool_factor": p.pool_factor, "t_size": p.t_size,
         "tau_d": p.tau_d, "beta": p.beta,
         "clearance_fraction": if p.clearance_fraction.is_finite() { json!(p.clearance_fraction) } else { Value::Null },
@@ -156,9 +173,14 @@ pub fn report_json(s: &Simplified) -> Value {
     })
 }
 
-/// Runs LBO-ABGS with a progress bar on stderr (faces so far; hidden when
-/// stderr is not a terminal).
-pub fn run_lbo(dense: &Grid, params: &SimplifyParams) -> Result<Simplified> {
+/// Runs LBO-ABGS or GCN-ABGS (`params.method`; GCN-ABGS with the model file
+/// `model` in place of the embedded model when given) with a progress bar on
+/// stderr (faces so far; hidden when stderr is not a terminal).
+pub fn run_abgs(dense: &Grid, params: &SimplifyParams, model: Option<&Path>) -> Result<Simplified> {
+    let loaded = match (params.method, model) {
+        (LibMethod::Gcn, Some(path)) => Some(Model::from_file(path)?),
+        _ => None,
+    };
     let pb = ProgressBar::new(dense.triangles().len() as u64);
     pb.set_style(
         ProgressStyle::with_template("simplifying {bar:30} {msg} [{elapsed}]")
@@ -169,7 +191,10 @@ pub fn run_lbo(dense: &Grid, params: &SimplifyParams) -> Result<Simplified> {
         pb.set_message(format!("iteration {} · {} faces", r.iteration, r.faces));
         true
     };
-    let s = simplify(dense, params, Some(&mut cb));
+    let s = match &loaded {
+        Some(m) => simplify_with(dense, params, &mut Learned::new(m), Some(&mut cb)),
+        None => simplify(dense, params, Some(&mut cb)),
+    };
     pb.finish_and_clear();
     s
 }
@@ -191,9 +216,12 @@ pub fn run(
         )));
     }
     let value = match method {
-        Method::Lbo => {
-            let params = args.params();
-            let s = run_lbo(&dense, &params)?;
+        Method::Lbo | Method::Gcn => {
+            let mut params = args.params();
+            if method == Method::Gcn {
+                params.method = LibMethod::Gcn;
+            }
+            let s = run_abgs(&dense, &params, args.lbo.model.as_deref())?;
             s.grid.save(output)?;
             let r = &s.report;
             eprintln!(

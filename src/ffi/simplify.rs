@@ -11,8 +11,8 @@ use std::ffi::c_void;
 /// Method (`abgs_simplify_params.method`): LBO-ABGS, the procedural
 /// simplifier (accurate estimation of every candidate).
 pub const ABGS_METHOD_LBO: u32 = 0;
-/// Method: GCN-ABGS, the learned simplifier: not in this build
-/// (ABGS_ERR_NOT_AVAILABLE).
+/// Method: GCN-ABGS, the learned simplifier (the embedded graph network
+/// predicts every edge's errors in one pass; `t_score` and `verify` apply).
 pub const ABGS_METHOD_GCN: u32 = 1;
 
 /// Why a simplification stopped (`abgs_simplify_report.stop`): nothing could
@@ -107,6 +107,12 @@ pub struct abgs_simplify_params {
     /// Each side of a thin wall or gap may move at most this fraction of its
     /// width, > 0 (default 0.25); 0 turns the clearance term off.
     pub clearance_fraction: f64,
+    /// ABGS_METHOD_GCN: edges whose predicted score is at or above this, in
+    /// [0, 1], are not tried (default 0.5, "predicted not collapsible").
+    pub t_score: f64,
+    /// ABGS_METHOD_GCN: 1 = run the accurate estimate on the edges the model
+    /// proposes and drop those that fail it (default 0).
+    pub verify: u32,
 }
 
 /// What `abgs_simplify` did.
@@ -164,6 +170,8 @@ fn default_params() -> abgs_simplify_params {
         user_data: std::ptr::null_mut(),
         beta: d.beta,
         clearance_fraction: d.clearance_fraction,
+        t_score: d.t_score,
+        verify: d.verify as u32,
     }
 }
 
@@ -210,6 +218,7 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
         (p.max_angle_deg, "max_angle_deg"),
         (p.beta, "beta"),
         (p.clearance_fraction, "clearance_fraction"),
+        (p.t_score, "t_score"),
     ] {
         if !x.is_finite() {
             return err(
@@ -230,6 +239,12 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
             );
         }
     }
+    if p.verify > 1 {
+        return err(
+            abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+            format!("verify = {} must be 0 or 1", p.verify),
+        );
+    }
     if p.max_iterations == 0 {
         return err(
             abgs_status::ABGS_ERR_INVALID_ARGUMENT,
@@ -237,6 +252,13 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
         );
     }
     let params = SimplifyParams {
+        method: if p.method == ABGS_METHOD_GCN {
+            simplify::Method::Gcn
+        } else {
+            simplify::Method::Lbo
+        },
+        t_score: p.t_score,
+        verify: p.verify == 1,
         fraction: p.fraction,
         pool_factor: p.pool_factor,
         t_size: p.t_size,
@@ -277,7 +299,8 @@ fn record(r: &IterationRecord) -> abgs_iteration_record {
 }
 
 /// Simplifies the dense grid `grid` (which must carry sizes) into a new grid
-/// with sizes: edge collapses chosen by accurate estimation (LBO-ABGS), each
+/// with sizes: edge collapses chosen by accurate estimation (LBO-ABGS) or by
+/// the embedded model's predictions (GCN-ABGS, `method`), each
 /// keeping the interpolated size within `t_size` of the dense grid's and the
 /// surface within `tau_d`·h (and `max_distance`) of it; feature lines,
 /// corners, boundaries and bodies are kept. `params` NULL = the defaults.
@@ -292,7 +315,8 @@ fn record(r: &IterationRecord) -> abgs_iteration_record {
 /// iterations, C candidates estimated with S samples each (parallel).
 ///
 /// Errors: NULL (grid, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
-/// NOT_AVAILABLE (ABGS_METHOD_GCN), NO_SIZES, BUSY (a mutation is running on `grid`).
+/// NO_SIZES, BUSY (a mutation is running on `grid`), INVALID_ARGUMENT naming
+/// the model when the embedded model cannot run.
 ///
 /// # Safety
 /// Pointers are NULL (reported / "absent" where documented) or valid; `grid`
@@ -316,12 +340,6 @@ pub unsafe extern "C" fn abgs_simplify(
         // before the work so that a bad struct_size fails fast.
         unsafe { check_out(out_report, "out_report", true)? };
         let rp = to_params(&p)?;
-        if p.method == ABGS_METHOD_GCN {
-            return err(
-                abgs_status::ABGS_ERR_NOT_AVAILABLE,
-                "the learned simplifier (GCN-ABGS) is not available in this build; use ABGS_METHOD_LBO",
-            );
-        }
         let g = h.read()?;
         if g.sizes().is_none() {
             return err(abgs_status::ABGS_ERR_NO_SIZES, "the grid has no sizes");

@@ -27,24 +27,44 @@
 //! order, so the output bits do not depend on the thread count.
 
 pub mod envelope;
-mod estimate;
+pub mod estimate;
 mod repair;
-mod select;
+pub mod scorer;
+pub mod select;
 mod target;
 
 pub use estimate::{Binding, Estimate, Limits};
+pub use scorer::{Accurate, EdgeScorer, Ranking, Stamps, View};
 pub use target::{Hit, Target};
 
 use crate::error::{Error, Result};
 use crate::mesh::feature_lines::{feature_lines, FeatureLines};
-use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED, NONE, V_CORNER};
+use crate::mesh::halfedge::{HalfedgeMesh, NONE, V_CORNER};
 use crate::mesh::{BuildOptions, Features, Grid};
 use rayon::prelude::*;
 use std::time::Instant;
 
-/// Parameters of LBO-ABGS (defaults from DESIGN §3.5).
+/// Which scorer ranks the edges (see [`scorer`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// LBO-ABGS: the accurate estimate of each candidate (DESIGN §3.5).
+    #[default]
+    Lbo,
+    /// GCN-ABGS: the embedded graph network's predictions (DESIGN §3.6).
+    Gcn,
+}
+
+/// Parameters of LBO-ABGS and GCN-ABGS (defaults from DESIGN §3.5–3.6).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimplifyParams {
+    /// The scorer (default LBO-ABGS).
+    pub method: Method,
+    /// GCN-ABGS: edges whose predicted score is at or above this are not
+    /// tried (`T_score`, default 0.5: "predicted not collapsible").
+    pub t_score: f64,
+    /// GCN-ABGS: run the accurate estimate on the edges the model proposes
+    /// and drop those that fail it (default false).
+    pub verify: bool,
     /// Largest share of the edges collapsed per iteration (`n`, default 0.10).
     pub fraction: f64,
     /// Candidate pool size as a multiple of `n·|E|` (default 2).
@@ -85,6 +105,9 @@ pub struct SimplifyParams {
 impl Default for SimplifyParams {
     fn default() -> Self {
         SimplifyParams {
+            method: Method::Lbo,
+            t_score: 0.5,
+            verify: false,
             fraction: 0.10,
             pool_factor: 2.0,
             t_size: 1.2,
@@ -107,6 +130,7 @@ impl SimplifyParams {
     pub fn check(&self) -> Result<()> {
         let within = crate::error::check_range;
         within(self.fraction, 1e-9, 1.0, "fraction")?;
+        within(self.t_score, 0.0, 1.0, "t_score")?;
         within(self.pool_factor, 1.0, 1e6, "pool_factor")?;
         within(self.t_size, 1.0 + 1e-9, 1e9, "t_size")?;
         if let Some(t) = self.tau_d {
@@ -125,7 +149,8 @@ impl SimplifyParams {
         within(self.max_angle_deg, 60.0, 180.0, "max_angle_deg")
     }
 
-    fn limits(&self) -> Limits {
+    /// The thresholds of one estimate.
+    pub fn limits(&self) -> Limits {
         let size_term = match self.tau_d {
             Some(t) => envelope::SizeTerm::Fixed(t),
             None => envelope::SizeTerm::Derived {
@@ -360,16 +385,54 @@ fn own_element_count(mesh: &HalfedgeMesh) -> f64 {
     total * 4.0 / 3f64.sqrt()
 }
 
-/// Simplifies the target grid `grid` (which must carry sizes) by LBO-ABGS.
-/// `progress` is called after every iteration that collapsed something (not
-/// after the final one that found nothing); returning `false` stops the loop,
-/// leaving a valid grid. Errors on invalid parameters or a grid
-/// without sizes. About O(I · (E log E + C · S log F)) for I iterations,
-/// C candidates estimated afresh and S samples per estimate.
+/// Simplifies the target grid `grid` (which must carry sizes) by the
+/// method of `params.method`: LBO-ABGS (the accurate estimate) or GCN-ABGS
+/// (the embedded model; see [`crate::gcn`]). `progress` is called after every
+/// iteration that collapsed something (not after the final one that found
+/// nothing); returning `false` stops the loop, leaving a valid grid. Errors on
+/// invalid parameters, a grid without sizes, or a model that cannot run.
+/// LBO-ABGS costs about O(I · (E log E + C · S log F)) for I iterations, C
+/// candidates estimated afresh and S samples per estimate; GCN-ABGS replaces
+/// the C · S log F term by one forward pass per iteration.
 pub fn simplify(
     grid: &Grid,
     params: &SimplifyParams,
+    progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
+) -> Result<Simplified> {
+    match params.method {
+        Method::Lbo => simplify_with(grid, params, &mut Accurate::default(), progress),
+        Method::Gcn => {
+            let model = crate::gcn::embedded_model()?;
+            let mut scorer = crate::gcn::Learned::new(model);
+            simplify_with(grid, params, &mut scorer, progress)
+        }
+    }
+}
+
+/// [`simplify`] with any scorer (the loop's seam: see [`scorer`]);
+/// `params.method` is not read.
+pub fn simplify_with(
+    grid: &Grid,
+    params: &SimplifyParams,
+    scorer: &mut dyn EdgeScorer,
+    progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
+) -> Result<Simplified> {
+    run_loop(grid, params, scorer, progress, None)
+}
+
+/// What [`run_loop`] shows an observer: the state before each iteration's
+/// ranking, and once more at the end.
+pub type Observer<'o> = &'o mut dyn FnMut(&View) -> Result<()>;
+
+/// The loop shared by every scorer. `observer` sees the grid before each
+/// iteration's ranking and the final grid (with `iteration` one past the
+/// last); its error stops the loop.
+pub(crate) fn run_loop(
+    grid: &Grid,
+    params: &SimplifyParams,
+    scorer: &mut dyn EdgeScorer,
     mut progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
+    mut observer: Option<Observer>,
 ) -> Result<Simplified> {
     let start = Instant::now();
     let (mut mesh, parts) = setup(grid, params)?;
@@ -388,72 +451,39 @@ pub fn simplify(
         stop: StopReason::MaxIterations,
         ..Default::default()
     };
-    // Estimates kept between iterations, with the iteration that made them.
-    let mut cache: Vec<Option<(u32, Estimate)>> = vec![None; mesh.n_edges()];
-    let mut stamps = Stamps {
-        moved: vec![0; mesh.n_vertices()],
-        ring: vec![0; mesh.n_vertices()],
-    };
+    let mut stamps = Stamps::new(mesh.n_vertices());
     let mut used = vec![false; mesh.n_vertices()];
-    let mut ring = Vec::new();
     for it in 1..=params.max_iterations as u32 {
         let t = Instant::now();
         let live = mesh.edge_count();
-        let lbo = select::edge_lbo(&mesh);
-        let mut order: Vec<u32> = mesh
-            .edges()
-            .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED == 0)
-            .collect();
-        order.sort_by(|&a, &b| lbo[a as usize].total_cmp(&lbo[b as usize]).then(a.cmp(&b)));
-        let pool_size = (params.pool_factor * params.fraction * live as f64).ceil() as usize;
-        let mut pool = Vec::with_capacity(pool_size);
-        let mut fresh = Vec::new();
-        for e in order {
-            if pool.len() >= pool_size {
-                break;
-            }
-            let known =
-                cache[e as usize].filter(|(made, _)| stamps.unchanged(&mesh, e, *made, &mut ring));
-            match known {
-                Some((_, est)) if !est.collapsible() => continue,
-                Some(_) => pool.push(e),
-                None => {
-                    pool.push(e);
-                    fresh.push(e);
-                }
-            }
-        }
-        let estimates: Vec<Estimate> = {
-            let m = &mesh;
-            fresh
-                .par_iter()
-                .map(|&e| estimate::estimate(m, &target, e, &lim, 0.5))
-                .collect()
+        let view = View {
+            mesh: &mesh,
+            target: &target,
+            lim: &lim,
+            params,
+            stamps: &stamps,
+            iteration: it,
+            last: false,
         };
-        for (&e, est) in fresh.iter().zip(estimates) {
-            cache[e as usize] = Some((it, est));
+        if let Some(obs) = observer.as_mut() {
+            obs(&view)?;
         }
-        let mut ranked: Vec<(f64, u32)> = pool
-            .iter()
-            .filter_map(|&e| {
-                let (_, est) = cache[e as usize]?;
-                est.collapsible().then_some((est.y, e))
-            })
-            .collect();
-        ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let ranked_edges: Vec<u32> = ranked.iter().map(|x| x.1).collect();
+        let ranking = scorer.rank(&view)?;
+        let ranked_edges: Vec<u32> = ranking.ranked.iter().map(|x| x.0).collect();
         let limit = ((params.fraction * live as f64).floor() as usize).max(1);
         let chosen = select::disjoint_rings(&mesh, &ranked_edges, limit, &mut used);
         let mut rec = IterationRecord {
             iteration: it as usize,
-            candidates: pool.len(),
-            estimated: fresh.len(),
-            collapsible: ranked.len(),
+            candidates: ranking.candidates,
+            estimated: ranking.estimated,
+            collapsible: ranking.ranked.len(),
             ..Default::default()
         };
+        let by_edge: std::collections::HashMap<u32, Estimate> =
+            ranking.ranked.iter().copied().collect();
         let mut kept = Vec::with_capacity(chosen.len());
         for e in &chosen {
-            let Some((_, est)) = cache[*e as usize] else {
+            let Some(&est) = by_edge.get(e) else {
                 continue;
             };
             let w = mesh.to_vertex(est.halfedge);
@@ -503,6 +533,18 @@ pub fn simplify(
             }
         }
     }
+    if let Some(obs) = observer.as_mut() {
+        let last = report.iterations.len() as u32 + 1;
+        obs(&View {
+            mesh: &mesh,
+            target: &target,
+            lim: &lim,
+            params,
+            stamps: &stamps,
+            iteration: last,
+            last: true,
+        })?;
+    }
     report.binding = census(&mesh, &target, &lim);
     let out = finish(&mesh)?;
     report.faces_out = out.triangles().len();
@@ -524,32 +566,6 @@ fn census(mesh: &HalfedgeMesh, target: &Target, lim: &Limits) -> BindingCounts {
         counts.add(b);
     }
     counts
-}
-
-/// When each vertex last changed: `moved` (position or size) and `ring`
-/// (its set of neighbours), as iteration numbers (0 = never).
-struct Stamps {
-    moved: Vec<u32>,
-    ring: Vec<u32>,
-}
-
-impl Stamps {
-    /// Is an estimate of edge `e` made at iteration `made` still exact? It
-    /// reads the faces around the two ends (their rings, and the positions
-    /// and sizes of every vertex there) and the valence of the two apexes.
-    fn unchanged(&self, mesh: &HalfedgeMesh, e: u32, made: u32, ring: &mut Vec<u32>) -> bool {
-        let [a, b] = mesh.edge_vertices(e);
-        if self.ring[a as usize] >= made || self.ring[b as usize] >= made {
-            return false;
-        }
-        for h in [2 * e, 2 * e + 1] {
-            if mesh.face(h) != NONE && self.ring[mesh.to_vertex(mesh.next(h)) as usize] >= made {
-                return false;
-            }
-        }
-        select::closed_ring(mesh, e, ring);
-        ring.iter().all(|&v| self.moved[v as usize] < made)
-    }
 }
 
 /// The live mesh as a grid with sizes (locked copies merged back).

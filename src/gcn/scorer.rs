@@ -1,0 +1,138 @@
+//! GCN-ABGS's scorer (DESIGN §3.6): the model predicts every edge's two
+//! unit-free errors in one forward pass; the loop's thresholds turn them
+//! into scores, and only the best predictions get the cheap exact checks.
+//!
+//! Per iteration:
+//! 1. [`super::features::graph`] of the current grid, one forward pass:
+//!    `p = (Δs − 1, Δd / h_loc)` per edge;
+//! 2. the predicted score `ŷ = min(1, ½·max(p₀/(T_size − 1), p₁·h_loc/a_e,
+//!    p₁·h_loc/max_distance))`, with `a_e` the distance envelope at the
+//!    edge ([`edge_allowance`]): the same formula as the accurate score, so
+//!    `T_size`, `β`, `κ` and `max_distance` stay run-time parameters;
+//! 3. edges with `ŷ < T_score`, lowest first (ties by edge index), at most
+//!    `pool_factor·n·|E|` of them, get the placement and validity checks of
+//!    the accurate estimate without its sampling
+//!    ([`crate::simplify::estimate::estimate`] with `exit_at = 0`: link
+//!    condition, feature rules, normal turn, largest angle, and the removed
+//!    vertex's exact distance to the new faces against the envelope); with
+//!    `verify`, the full accurate estimate instead, and edges it finds not
+//!    collapsible are dropped.
+//!
+//! The loop then applies the shared 1-ring filter and collapses. The loop
+//! ends when no edge is predicted below `T_score` or none passes the checks.
+//!
+//! Cost per iteration: the features O(F + E + N·K), the model O(E·D² + N·K·D)
+//! for hidden width D, the checks O(C·valence²) for C ≤ pool edges (with
+//! `verify`, O(C·S log F)). Deterministic: the model runs single-threaded on
+//! inputs that do not depend on the thread count, the checks are collected
+//! in edge order.
+
+use super::features::graph;
+use super::runtime::Model;
+use crate::error::Result;
+use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED};
+use crate::simplify::estimate::{self, Estimate, Limits};
+use crate::simplify::scorer::{EdgeScorer, Ranking, View};
+use crate::simplify::Target;
+use rayon::prelude::*;
+
+/// The distance envelope at edge `e` in model units: the smaller of the
+/// envelopes at the target triangles its two ends were projected from, for
+/// `h_loc` the smaller size at the ends. O(1).
+pub fn edge_allowance(mesh: &HalfedgeMesh, target: &Target, e: u32, lim: &Limits) -> f64 {
+    let [a, b] = mesh.edge_vertices(e);
+    let h_loc = mesh.vertex_size[a as usize].min(mesh.vertex_size[b as usize]);
+    [a, b]
+        .map(|v| target.allowance(mesh.vertex_hint[v as usize], h_loc, h_loc, lim))
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The predicted score of an edge from the model's `(Δs − 1, Δd / h_loc)`,
+/// by the accurate score's own formula ([`estimate::score`]).
+pub fn predicted_score(p: [f32; 2], h_loc: f64, allowance: f64, lim: &Limits) -> f64 {
+    let ds = 1.0 + p[0].max(0.0) as f64;
+    let dd = p[1].max(0.0) as f64 * h_loc;
+    let de = if allowance > 0.0 {
+        dd / allowance
+    } else {
+        f64::INFINITY
+    };
+    estimate::score(ds, de, dd, lim)
+}
+
+/// GCN-ABGS's scorer over a loaded model (see the module doc).
+pub struct Learned<'m> {
+    model: &'m Model,
+    /// Seconds spent in the forward passes (features included).
+    pub model_seconds: f64,
+}
+
+impl<'m> Learned<'m> {
+    /// A scorer running `model`.
+    pub fn new(model: &'m Model) -> Learned<'m> {
+        Learned {
+            model,
+            model_seconds: 0.0,
+        }
+    }
+
+    /// Predicted scores `ŷ` for every edge slot of `view.mesh` (∞ for
+    /// removed edges). One forward pass.
+    pub fn predict(&mut self, view: &View) -> Result<Vec<f64>> {
+        let t = std::time::Instant::now();
+        let mesh = view.mesh;
+        let g = graph(mesh)?;
+        let pred = self.model.predict(&g.inputs)?;
+        let mut y = vec![f64::INFINITY; mesh.n_edges()];
+        let scored: Vec<f64> = g
+            .edges
+            .par_iter()
+            .zip(pred.par_iter())
+            .map(|(&e, &p)| {
+                let [a, b] = mesh.edge_vertices(e);
+                let h_loc = mesh.vertex_size[a as usize].min(mesh.vertex_size[b as usize]);
+                let allow = edge_allowance(mesh, view.target, e, view.lim);
+                predicted_score(p, h_loc, allow, view.lim)
+            })
+            .collect();
+        for (&e, s) in g.edges.iter().zip(scored) {
+            y[e as usize] = s;
+        }
+        self.model_seconds += t.elapsed().as_secs_f64();
+        Ok(y)
+    }
+}
+
+impl EdgeScorer for Learned<'_> {
+    fn rank(&mut self, view: &View) -> Result<Ranking> {
+        let mesh = view.mesh;
+        let y = self.predict(view)?;
+        let p = view.params;
+        let mut order: Vec<(f64, u32)> = mesh
+            .edges()
+            .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED == 0)
+            .map(|e| (y[e as usize], e))
+            .filter(|&(s, _)| s < p.t_score)
+            .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let pool = (p.pool_factor * p.fraction * mesh.edge_count() as f64).ceil() as usize;
+        order.truncate(pool);
+        let exit_at = if p.verify { 0.5 } else { 0.0 };
+        let checked: Vec<Estimate> = order
+            .par_iter()
+            .map(|&(_, e)| estimate::estimate(mesh, view.target, e, view.lim, exit_at))
+            .collect();
+        let ranked = order
+            .iter()
+            .zip(checked)
+            .filter(|(_, est)| est.collapsible())
+            .map(|(&(_, e), est)| (e, est))
+            .collect();
+        Ok(Ranking {
+            ranked,
+            candidates: order.len(),
+            estimated: order.len(),
+        })
+    }
+}

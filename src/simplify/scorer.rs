@@ -1,0 +1,177 @@
+//! The scorer seam of the simplification loop (DESIGN §3.5 steps 1–3 and
+//! §3.6): which edges an iteration tries to collapse, in which order, and
+//! where each collapse puts its kept vertex.
+//!
+//! Everything else in the loop is shared by every scorer: the 1-ring filter
+//! ([`super::select::disjoint_rings`]), the collapses, the local repair, the
+//! re-projection of sizes and the stop rule (an iteration that collapses
+//! nothing ends the loop). A scorer only ranks: it hands the loop the edges
+//! it finds collapsible, best first, each with an [`Estimate`] whose
+//! placement (half-edge, position, size, hint) the collapse uses.
+//!
+//! Implementations, with their cost per iteration (E live edges, C
+//! candidates, S samples per accurate estimate, F target faces):
+//!
+//! - [`Accurate`] (LBO-ABGS): ranks the edges by the LBO of the size field,
+//!   estimates the best-ranked `2·n·|E|` exactly as their collapses would go
+//!   (sampled sizes and distances, [`super::estimate`]). O(E log E + C·S log F),
+//!   with estimates kept until their neighbourhood changes.
+//! - `gcn::scorer::Learned` (GCN-ABGS): one forward pass of the embedded
+//!   graph network predicts every edge's two unit-free errors; only the
+//!   placement and the cheap validity checks (link condition, normal turn,
+//!   angles, the removed vertex's distance) are computed, on the best
+//!   predictions. O(E·K·D² model + E log E + C·valence²).
+//!
+//! Both give the same bits for any thread count: parallel work is collected
+//! in edge order and ranked with ties broken by edge index.
+
+use super::estimate::{self, Estimate, Limits};
+use super::select;
+use super::target::Target;
+use super::SimplifyParams;
+use crate::error::Result;
+use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED};
+use rayon::prelude::*;
+
+/// What a scorer sees of one iteration: the grid being simplified, the
+/// target it must stay faithful to, the thresholds, and when each vertex last
+/// changed.
+pub struct View<'a> {
+    /// The grid being simplified (its current state).
+    pub mesh: &'a HalfedgeMesh,
+    /// The dense target grid with its patches, lines and envelope.
+    pub target: &'a Target<'a>,
+    /// The thresholds of one estimate.
+    pub lim: &'a Limits,
+    /// The run's parameters.
+    pub params: &'a SimplifyParams,
+    /// When each vertex last changed.
+    pub stamps: &'a Stamps,
+    /// The iteration (1-based).
+    pub iteration: u32,
+    /// The loop has ended (an observer's last look at the result).
+    pub last: bool,
+}
+
+/// A scorer's answer for one iteration.
+#[derive(Debug, Clone, Default)]
+pub struct Ranking {
+    /// Edges to collapse, best first, each with the estimate whose placement
+    /// its collapse uses; all collapsible.
+    pub ranked: Vec<(u32, Estimate)>,
+    /// Edges considered (the candidate pool).
+    pub candidates: usize,
+    /// Edges estimated or checked afresh this iteration.
+    pub estimated: usize,
+}
+
+/// A strategy that ranks the edges of one iteration (the seam between
+/// LBO-ABGS and GCN-ABGS; see the module doc for each one's cost).
+pub trait EdgeScorer {
+    /// Ranks the edges of `view.mesh` for this iteration. Errors only when
+    /// the scorer itself fails (e.g. a model that cannot be run).
+    fn rank(&mut self, view: &View) -> Result<Ranking>;
+}
+
+/// When each vertex last changed: `moved` (position or size) and `ring`
+/// (its set of neighbours), as iteration numbers (0 = never).
+pub struct Stamps {
+    /// Last iteration that moved the vertex or changed its size.
+    pub moved: Vec<u32>,
+    /// Last iteration that changed its neighbours.
+    pub ring: Vec<u32>,
+}
+
+impl Stamps {
+    /// No vertex of an `n`-vertex mesh changed yet.
+    pub fn new(n: usize) -> Stamps {
+        Stamps {
+            moved: vec![0; n],
+            ring: vec![0; n],
+        }
+    }
+
+    /// Is an estimate of edge `e` made at iteration `made` still exact? It
+    /// reads the faces around the two ends (their rings, and the positions
+    /// and sizes of every vertex there) and the valence of the two apexes.
+    pub fn unchanged(&self, mesh: &HalfedgeMesh, e: u32, made: u32, ring: &mut Vec<u32>) -> bool {
+        let [a, b] = mesh.edge_vertices(e);
+        if self.ring[a as usize] >= made || self.ring[b as usize] >= made {
+            return false;
+        }
+        for h in [2 * e, 2 * e + 1] {
+            if mesh.face(h) != crate::mesh::halfedge::NONE
+                && self.ring[mesh.to_vertex(mesh.next(h)) as usize] >= made
+            {
+                return false;
+            }
+        }
+        select::closed_ring(mesh, e, ring);
+        ring.iter().all(|&v| self.moved[v as usize] < made)
+    }
+}
+
+/// LBO-ABGS's scorer: LBO ranking, then the accurate estimate of the
+/// best-ranked `pool_factor·n·|E|` edges not already known to be
+/// non-collapsible. An estimate is kept until a vertex of its closed 1-ring
+/// changes, so an unchanged edge is never estimated twice. Memory O(E).
+#[derive(Debug, Default)]
+pub struct Accurate {
+    cache: Vec<Option<(u32, Estimate)>>,
+    ring: Vec<u32>,
+}
+
+impl EdgeScorer for Accurate {
+    fn rank(&mut self, view: &View) -> Result<Ranking> {
+        let mesh = view.mesh;
+        if self.cache.len() < mesh.n_edges() {
+            self.cache.resize(mesh.n_edges(), None);
+        }
+        let live = mesh.edge_count();
+        let lbo = select::edge_lbo(mesh);
+        let mut order: Vec<u32> = mesh
+            .edges()
+            .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED == 0)
+            .collect();
+        order.sort_by(|&a, &b| lbo[a as usize].total_cmp(&lbo[b as usize]).then(a.cmp(&b)));
+        let p = view.params;
+        let pool_size = (p.pool_factor * p.fraction * live as f64).ceil() as usize;
+        let mut pool = Vec::with_capacity(pool_size);
+        let mut fresh = Vec::new();
+        for e in order {
+            if pool.len() >= pool_size {
+                break;
+            }
+            let known = self.cache[e as usize]
+                .filter(|(made, _)| view.stamps.unchanged(mesh, e, *made, &mut self.ring));
+            match known {
+                Some((_, est)) if !est.collapsible() => continue,
+                Some(_) => pool.push(e),
+                None => {
+                    pool.push(e);
+                    fresh.push(e);
+                }
+            }
+        }
+        let estimates: Vec<Estimate> = fresh
+            .par_iter()
+            .map(|&e| estimate::estimate(mesh, view.target, e, view.lim, 0.5))
+            .collect();
+        for (&e, est) in fresh.iter().zip(estimates) {
+            self.cache[e as usize] = Some((view.iteration, est));
+        }
+        let mut ranked: Vec<(u32, Estimate)> = pool
+            .iter()
+            .filter_map(|&e| {
+                let (_, est) = self.cache[e as usize]?;
+                est.collapsible().then_some((e, est))
+            })
+            .collect();
+        ranked.sort_by(|a, b| a.1.y.total_cmp(&b.1.y).then(a.0.cmp(&b.0)));
+        Ok(Ranking {
+            ranked,
+            candidates: pool.len(),
+            estimated: fresh.len(),
+        })
+    }
+}
