@@ -19,7 +19,7 @@
 #   N_TRAIN N_VAL N_TEST   parts per split (default 120 / 15 / 15)
 #   SEED        training seed (default 0)
 #   EPOCHS      training epochs (default 40); TRAIN_MIN safety stop in minutes (default 40)
-#   GRID_ARGS   options of `abgs grid` (default "--relative 0.015")
+#   GRID_ARGS   options of `abgs grid` (default "--relative 0.02": dense grids of ~5-20k faces)
 #   DATASET_ARGS options of `abgs dataset` (default "--snapshots 6")
 set -euo pipefail
 
@@ -35,11 +35,27 @@ N_TEST=${N_TEST:-15}
 SEED=${SEED:-0}
 EPOCHS=${EPOCHS:-40}
 TRAIN_MIN=${TRAIN_MIN:-40}
-GRID_ARGS=${GRID_ARGS:---relative 0.015}
+GRID_ARGS=${GRID_ARGS:---relative 0.02}
 DATASET_ARGS=${DATASET_ARGS:---snapshots 6}
 # part seeds per split: part k of a split uses seed base+k, so the bases are
 # further apart than the counts (disjoint parts)
 SEED_TRAIN=1000 SEED_VAL=20000 SEED_TEST=30000
+
+# the exact invocation, for the model card: every setting that differs from the default
+INVOCATION=""
+for v in N_TRAIN N_VAL N_TEST SEED EPOCHS TRAIN_MIN GRID_ARGS DATASET_ARGS JOBS; do
+  case "$v=${!v}" in
+    "N_TRAIN=120"|"N_VAL=15"|"N_TEST=15"|"SEED=0"|"EPOCHS=40"|"TRAIN_MIN=40"|"JOBS=2") ;;
+    "GRID_ARGS=--relative 0.02"|"DATASET_ARGS=--snapshots 6") ;;
+    *) INVOCATION+="$v=\"${!v}\" " ;;
+  esac
+done
+INVOCATION+="training/build_model.sh"
+REV=$(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)
+if [ -n "$(git -C "$ROOT" status --porcelain -- src cli Cargo.toml Cargo.lock 2>/dev/null)" ]; then
+  REV+="+uncommitted"
+fi
+[ -n "${ABGS_BIN:-}" ] && REV="given binary ABGS_BIN, checkout $REV"
 
 t_all=$(date +%s)
 stage() { echo "== $* ($(($(date +%s) - t_all)) s)" >&2; }
@@ -100,9 +116,10 @@ one_part() { # stl -> data/<split>/<name>.safetensors
   tmp=$WORK/tmp/$split/$name
   mkdir -p "$tmp" "$WORK/data/$split" "$WORK/logs/$split"
   local log=$WORK/logs/$split/$name.log
+  # (the sized grid is named after the part: it is the dataset's "source")
   if RAYON_NUM_THREADS=1 "$BIN" grid "$stl" -o "$tmp/dense.vtk" $GRID_ARGS >"$log" 2>&1 &&
-     RAYON_NUM_THREADS=1 "$BIN" size "$tmp/dense.vtk" -o "$tmp/sized.vtk" >>"$log" 2>&1 &&
-     RAYON_NUM_THREADS=1 "$BIN" dataset "$tmp/sized.vtk" -o "$tmp/part.safetensors" $DATASET_ARGS >>"$log" 2>&1; then
+     RAYON_NUM_THREADS=1 "$BIN" size "$tmp/dense.vtk" -o "$tmp/$name.vtk" >>"$log" 2>&1 &&
+     RAYON_NUM_THREADS=1 "$BIN" dataset "$tmp/$name.vtk" -o "$tmp/part.safetensors" $DATASET_ARGS >>"$log" 2>&1; then
     mv "$tmp/part.safetensors" "$out"
     rm -rf "$tmp"
   else
@@ -122,7 +139,9 @@ T[datasets]=$(($(date +%s) - t))
 # 5. train + export + check
 stage "training"
 cat >"$WORK/build.json" <<EOF
-{"command": "training/build_model.sh", "seconds_before_training": $(($(date +%s) - t_all)),
+{"command": $(printf '%s' "$INVOCATION" | "$VENV/bin/python" -c 'import json,sys; print(json.dumps(sys.stdin.read()))'),
+ "abgs": "$("$BIN" --version) (source $REV)",
+ "seconds_before_training": $(($(date +%s) - t_all)),
  "stages_seconds": {"venv": ${T[venv]}, "cli": ${T[cli]}, "parts": ${T[parts]}, "datasets": ${T[datasets]}},
  "parts": {"train": $N_TRAIN, "val": $N_VAL, "test": $N_TEST,
            "seeds": {"train": $SEED_TRAIN, "val": $SEED_VAL, "test": $SEED_TEST}},

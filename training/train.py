@@ -194,7 +194,9 @@ def graph_labels(g, cap, alpha, scale):
     thr = np.stack([np.full(len(idx), math.log1p((g.t_size - 1.0) / scale[0])),
                     np.log1p(g.allow_rel[idx] / scale[1])], 1).astype(np.float32)
     # extra weight near the decision thresholds (in log space)
-    w = 1.0 + alpha * np.exp(-((tl - thr) / 0.15) ** 2)
+    with np.errstate(invalid="ignore", over="ignore"):
+        w = 1.0 + alpha * np.exp(-((tl - thr) / 0.15) ** 2)
+    w = np.where(np.isfinite(w), w, 1.0)
     return (torch.from_numpy(idx), torch.from_numpy(tl),
             torch.from_numpy(cens), torch.from_numpy(w.astype(np.float32)))
 
@@ -346,14 +348,15 @@ def predict(model, g):
 
 @torch.no_grad()
 def evaluate(model, graphs, cap, scale, max_rank=2_000_000, seed=0):
-    P, T, A, Y, TS, V = [], [], [], [], [], []
+    P, T, A, Y, TS, V, SN = [], [], [], [], [], [], []
     for g in graphs:
         p = predict(model, g)
         P.append(p), T.append(g.target), A.append(g.allow_rel), Y.append(g.y)
         TS.append(np.full(g.n_edges, g.t_size, np.float32)), V.append(g.valid)
-    P, T, A, Y, TS, V = map(np.concatenate, (P, T, A, Y, TS, V))
+        SN.append(np.full(g.n_edges, g.snapshot, np.int64))
+    P, T, A, Y, TS, V, SN = map(np.concatenate, (P, T, A, Y, TS, V, SN))
     m = V & ~np.isnan(T).any(1)
-    P, T, A, Y, TS = P[m], T[m], A[m], Y[m], TS[m]
+    P, T, A, Y, TS, SN = P[m], T[m], A[m], Y[m], TS[m], SN[m]
     tl, _ = transform_targets(T, cap)
     pl, _ = transform_targets(P, cap)
     ts, _ = transform_targets(T, cap, scale)
@@ -390,6 +393,18 @@ def evaluate(model, graphs, cap, scale, max_rank=2_000_000, seed=0):
         "score_spearman": spearman(y_pred[sub], Y[sub]),
         "truth_y_vs_targets_agreement": float((truth == truth_from_t).mean()),
     }
+    # by snapshot index (0 = dense grid; the last ones are the coarsest)
+    by = {}
+    for s in sorted(set(SN.tolist())):
+        k = SN == s
+        t, p = truth[k], pred_c[k]
+        tp = int((t & p).sum())
+        pr, rc = tp / max(int(p.sum()), 1), tp / max(int(t.sum()), 1)
+        by[str(s)] = {"edges_valid": int(k.sum()), "truth_share": float(t.mean()),
+                      "precision": pr, "recall": rc,
+                      "f1": 2 * pr * rc / max(pr + rc, 1e-12),
+                      "mae_log": [float(np.abs(pl[k, j] - tl[k, j]).mean()) for j in range(2)]}
+    out["by_snapshot"] = by
     return out
 
 
@@ -573,6 +588,12 @@ def write_card(path, rec):
         c = rec["metrics"][split]["collapsible"]
         lines.append(f"| {split} | {fmt(c['truth_share'])} | {fmt(c['predicted_share'])} | {fmt(c['precision'])} | "
                      f"{fmt(c['recall'])} | {fmt(c['f1'])} | {fmt(c['accuracy'])} | {fmt(c['score_spearman'])} |")
+    lines += ["", "By snapshot (test; 0 = dense grid, then coarser grids along the LBO-ABGS run):", "",
+              "| snapshot | valid edges | truly collapsible | precision | recall | F1 | MAE log1p (Δs−1, Δd/h_loc) |",
+              "|---|---|---|---|---|---|---|"]
+    for s, c in rec["metrics"]["test"]["by_snapshot"].items():
+        lines.append(f"| {s} | {c['edges_valid']} | {fmt(c['truth_share'])} | {fmt(c['precision'])} | "
+                     f"{fmt(c['recall'])} | {fmt(c['f1'])} | {fmt(c['mae_log'][0], 4)}, {fmt(c['mae_log'][1], 4)} |")
     oc = e["check"]
     lines += [
         "",
@@ -585,7 +606,8 @@ def write_card(path, rec):
         "## Rebuild",
         "",
         "```",
-        *(["training/build_model.sh   # everything, from nothing; it runs:"] if rec.get("build") else []),
+        *([f"{rec['build'].get('command', 'training/build_model.sh')}   # everything, from nothing; it runs:"]
+          if rec.get("build") else []),
         rec["command"],
         "```",
         "",
@@ -595,6 +617,8 @@ def write_card(path, rec):
         st = b.get("stages_seconds", {})
         total = b.get("seconds_before_training", 0) + rec["total_seconds"]
         lines += [
+            f"abgs CLI: {b.get('abgs', '?')}.",
+            "",
             f"Whole build (`{b.get('command', 'training/build_model.sh')}`, {b.get('cpu', '?')}, "
             f"{b.get('jobs', '?')} jobs): "
             + ", ".join(f"{k} {v} s" for k, v in st.items())
@@ -743,7 +767,16 @@ def main(argv=None):
     desc = a.description or (
         "Files `*.safetensors` written by `abgs dataset` (format abgs-dataset-1): snapshots "
         "(graphs) of LBO-ABGS runs on sized dense grids, labelled with the exact estimates.")
-    cmd = " ".join(["python", "training/train.py"] + [x for x in (argv or sys.argv[1:])])
+    args_shown, skip = [], False
+    for x in (argv if argv is not None else sys.argv[1:]):
+        if skip:
+            skip = False
+            continue
+        if x in ("--description", "--build-info", "--quiet"):
+            skip = x != "--quiet"
+            continue
+        args_shown.append(x if " " not in x else f"'{x}'")
+    cmd = " ".join(["python", "training/train.py"] + args_shown)
     rec = {
         "format": "gcn-abgs-model-1",
         "onnx": "gcn_abgs.onnx",
