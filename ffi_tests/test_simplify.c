@@ -45,6 +45,7 @@ int main(void) {
     CHECK(p.t_size == 1.2 && p.tau_d == 0.0 && p.max_distance == 0.0);
     CHECK(p.beta == 1.2 && p.clearance_fraction == 0.25);
     CHECK(p.max_iterations == 200 && p.repair == 1 && p.progress == NULL);
+    CHECK(p.t_score == 0.5 && p.verify == 0);
     CHECK_STATUS(abgs_simplify_params_default(NULL), ABGS_ERR_NULL);
     /* A struct whose struct_size was not set is refused, not overrun. */
     abgs_simplify_params z = {0};
@@ -147,8 +148,33 @@ int main(void) {
     CHECK_STATUS(abgs_simplify(dense, &p, NULL, NULL), ABGS_ERR_NULL);
     abgs_simplify_params bad = p;
     bad.method = ABGS_METHOD_GCN;
-    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_NOT_AVAILABLE);
+    bad.t_score = 1.5;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(abgs_last_error_message(), "t_score") != NULL);
+    bad.t_score = NAN;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_NON_FINITE);
+    bad.t_score = 0.5;
+    bad.verify = 3;
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(abgs_last_error_message(), "verify = 3") != NULL);
     CHECK(none == NULL);
+    /* GCN-ABGS (the embedded model), with and without the exact check of its
+       choices: fewer faces, sizes carried, and verify never keeps more than
+       the model alone would let through. */
+    for (uint32_t verify = 0; verify <= 1; verify++) {
+        abgs_simplify_params g = p;
+        g.method = ABGS_METHOD_GCN;
+        g.verify = verify;
+        abgs_grid *gout = NULL;
+        abgs_simplify_report gr = {.struct_size = sizeof gr};
+        CHECK_STATUS(abgs_simplify(dense, &g, &gout, &gr), ABGS_OK);
+        CHECK(gout != NULL && gr.faces_in == NT && gr.faces_out < NT / 2);
+        CHECK(gr.stop == ABGS_STOP_CONVERGED);
+        double q = 0.0, mid[3] = {0.5, 0.5, 0.0};
+        CHECK_STATUS(abgs_query_size(gout, mid, &q), ABGS_OK);
+        CHECK(fabs(q - (0.02 + 0.2 * 0.5)) < 0.2 * (0.02 + 0.2 * 0.5));
+        CHECK_STATUS(abgs_grid_free(gout), ABGS_OK);
+    }
     bad.method = 7; /* no such method: checked, never taken as an enum */
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
     CHECK(strstr(abgs_last_error_message(), "method = 7") != NULL);

@@ -53,8 +53,8 @@
 // simplifier (accurate estimation of every candidate).
 #define ABGS_METHOD_LBO 0
 
-// Method: GCN-ABGS, the learned simplifier: not in this build
-// (ABGS_ERR_NOT_AVAILABLE).
+// Method: GCN-ABGS, the learned simplifier (the embedded graph network
+// predicts every edge's errors in one pass; `t_score` and `verify` apply).
 #define ABGS_METHOD_GCN 1
 
 // Why a simplification stopped (`abgs_simplify_report.stop`): nothing could
@@ -399,6 +399,12 @@ typedef struct {
   // Each side of a thin wall or gap may move at most this fraction of its
   // width, > 0 (default 0.25); 0 turns the clearance term off.
   double clearance_fraction;
+  // ABGS_METHOD_GCN: edges whose predicted score is at or above this, in
+  // [0, 1], are not tried (default 0.5, "predicted not collapsible").
+  double t_score;
+  // ABGS_METHOD_GCN: 1 = run the accurate estimate on the edges the model
+  // proposes and drop those that fail it (default 0).
+  uint32_t verify;
 } abgs_simplify_params;
 
 // What `abgs_simplify` did.
@@ -878,7 +884,8 @@ abgs_status abgs_grid_remesh_issue(const abgs_grid *grid,
 abgs_status abgs_simplify_params_default(abgs_simplify_params *out_params);
 
 // Simplifies the dense grid `grid` (which must carry sizes) into a new grid
-// with sizes: edge collapses chosen by accurate estimation (LBO-ABGS), each
+// with sizes: edge collapses chosen by accurate estimation (LBO-ABGS) or by
+// the embedded model's predictions (GCN-ABGS, `method`), each
 // keeping the interpolated size within `t_size` of the dense grid's and the
 // surface within `tau_d`·h (and `max_distance`) of it; feature lines,
 // corners, boundaries and bodies are kept. `params` NULL = the defaults.
@@ -893,7 +900,8 @@ abgs_status abgs_simplify_params_default(abgs_simplify_params *out_params);
 // iterations, C candidates estimated with S samples each (parallel).
 //
 // Errors: NULL (grid, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
-// NOT_AVAILABLE (ABGS_METHOD_GCN), NO_SIZES, BUSY (a mutation is running on `grid`).
+// NO_SIZES, BUSY (a mutation is running on `grid`), INVALID_ARGUMENT naming
+// the model when the embedded model cannot run.
 //
 // # Safety
 // Pointers are NULL (reported / "absent" where documented) or valid; `grid`

@@ -1,8 +1,8 @@
 //! `abgs simplify` (LBO-ABGS or the QEM baseline) and `abgs label` (per-edge
 //! scores, the learned simplifier's training labels).
 
-use abgs::qem::{decimate, QemParams};
 use abgs::gcn::{Learned, Model};
+use abgs::qem::{decimate, QemParams};
 use abgs::simplify::{
     edge_scores, simplify, simplify_with, IterationRecord, Method as LibMethod, Simplified,
     SimplifyParams, StopReason,

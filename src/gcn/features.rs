@@ -89,10 +89,19 @@ impl GraphInputs {
         {
             return bad("a node index is out of range");
         }
-        if self.nbr_edge.iter().any(|&i| i < 0 || (i as usize >= e && i != 0)) {
+        if self
+            .nbr_edge
+            .iter()
+            .any(|&i| i < 0 || (i as usize >= e && i != 0))
+        {
             return bad("an edge index is out of range");
         }
-        if !self.node_x.iter().chain(&self.edge_x).all(|x| x.is_finite()) {
+        if !self
+            .node_x
+            .iter()
+            .chain(&self.edge_x)
+            .all(|x| x.is_finite())
+        {
             return bad("a feature is not finite");
         }
         Ok(())

@@ -1,0 +1,134 @@
+//! GCN-ABGS: training graphs along an LBO-ABGS run (their targets are the
+//! accurate estimate's own numbers), the embedded model through the `ort`
+//! API (deterministic, bad models refused), and the learned loop (same bits
+//! for any thread count, topology kept, sizes faithful).
+
+mod common;
+
+use abgs::gcn::dataset::{trajectory, write, DatasetParams, FORMAT};
+use abgs::simplify::{edge_scores, simplify, Method, SimplifyParams};
+use abgs::{BuildOptions, Grid};
+use common::shapes::icosphere;
+
+/// A sphere of radius 1 with a size field that varies over it.
+fn sized_sphere(level: usize) -> Grid {
+    let g = icosphere(1.0, level);
+    let h = g
+        .vertices()
+        .iter()
+        .map(|p| 0.08 + 0.06 * (1.0 + p[0]) + 0.02 * p[2] * p[2])
+        .collect();
+    Grid::from_arrays(
+        g.vertices().to_vec(),
+        g.triangles().to_vec(),
+        Some(h),
+        &BuildOptions {
+            weld_relative_tolerance: None,
+            orient: false,
+        },
+    )
+    .unwrap()
+}
+
+fn sorted_bits(mut v: Vec<[f32; 2]>) -> Vec<[u32; 2]> {
+    v.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    v.iter().map(|x| x.map(f32::to_bits)).collect()
+}
+
+#[test]
+fn dataset_targets_are_the_accurate_estimates_along_the_run() {
+    let g = sized_sphere(4);
+    let params = SimplifyParams::default();
+    let dp = DatasetParams::default();
+    let (snaps, report) = trajectory(&g, &params, &dp).unwrap();
+    assert!(
+        snaps.len() >= 3 && snaps.len() <= dp.snapshots,
+        "{}",
+        snaps.len()
+    );
+    // The dense grid first, the result last, faces falling in between.
+    assert_eq!(snaps[0].faces, report.faces_in);
+    assert_eq!(snaps.last().unwrap().faces, report.faces_out);
+    assert!(snaps.windows(2).all(|w| w[1].faces < w[0].faces));
+    for s in &snaps {
+        s.graph.check().unwrap();
+        let e = s.graph.n_edges;
+        assert_eq!((s.target.len(), s.valid.len(), s.y.len()), (e, e, e));
+        for i in 0..e {
+            let t = s.target[i];
+            if s.valid[i] == 1 {
+                assert!(t[0] >= 0.0 && t[1] >= 0.0, "{t:?}");
+                assert!(s.allow_rel[i] > 0.0);
+            } else {
+                assert!(t[0].is_nan() && t[1].is_nan() && s.y[i] == 1.0);
+            }
+        }
+    }
+    // The first snapshot's targets are exactly the dense grid's edge scores.
+    let scores = edge_scores(&g, &params).unwrap();
+    let expect: Vec<[f32; 2]> = scores
+        .iter()
+        .filter(|s| s.valid)
+        .map(|s| [(s.ds - 1.0) as f32, s.dd_rel as f32])
+        .collect();
+    let got: Vec<[f32; 2]> = (0..snaps[0].graph.n_edges)
+        .filter(|&i| snaps[0].valid[i] == 1)
+        .map(|i| snaps[0].target[i])
+        .collect();
+    assert_eq!(sorted_bits(got), sorted_bits(expect));
+    // Collapsible share falls along the run; few are left at the end (those
+    // whose collapse the mesh refuses, as the census reports them).
+    let last = snaps.last().unwrap();
+    let coll = |s: &abgs::gcn::dataset::Snapshot| {
+        (0..s.graph.n_edges)
+            .filter(|&i| s.valid[i] == 1 && s.y[i] < 0.5)
+            .count()
+    };
+    assert!(coll(&snaps[0]) > 0);
+    assert!(
+        coll(last) * 10 < coll(&snaps[0]),
+        "{} {}",
+        coll(last),
+        coll(&snaps[0])
+    );
+}
+
+#[test]
+fn dataset_file_reads_back() {
+    let g = sized_sphere(3);
+    let dp = DatasetParams {
+        snapshots: 3,
+        face_ratio: 0.5,
+    };
+    let (snaps, _) = trajectory(&g, &SimplifyParams::default(), &dp).unwrap();
+    let dir = std::env::temp_dir().join(format!("abgs_gcn_ds_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("d.safetensors");
+    write(&path, &snaps, &[("source", "sphere".into())]).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let (_, meta) = safetensors::SafeTensors::read_metadata(&bytes).unwrap();
+    let info = meta.metadata().as_ref().unwrap();
+    assert_eq!(info["format"], FORMAT);
+    assert_eq!(info["snapshots"], snaps.len().to_string());
+    assert_eq!(info["source"], "sphere");
+    let st = safetensors::SafeTensors::deserialize(&bytes).unwrap();
+    for (s, snap) in snaps.iter().enumerate() {
+        let t = st.tensor(&format!("{s}/edge_x")).unwrap();
+        assert_eq!(t.shape(), &[snap.graph.n_edges, 8]);
+        let back: Vec<f32> = t
+            .data()
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(back, snap.graph.edge_x);
+        let k = st.tensor(&format!("{s}/nbr_node")).unwrap();
+        assert_eq!(k.shape(), &[snap.graph.n_nodes, snap.graph.k]);
+    }
+    // A bad schedule is refused.
+    let bad = DatasetParams {
+        snapshots: 1,
+        face_ratio: 0.5,
+    };
+    assert!(trajectory(&g, &SimplifyParams::default(), &bad).is_err());
+    std::fs::remove_dir_all(&dir).ok();
+}
