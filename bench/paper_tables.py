@@ -65,7 +65,7 @@ def main():
         d = os.path.join(a.results, m)
         r[m] = {k: load(os.path.join(d, k + ".json")) for k in (
             "report", "queries_dense", "queries_simplified", "hausdorff_1t",
-            "hausdorff_mt", "decimation", "gmsh")}
+            "hausdorff_mt", "decimation", "gmsh", "gcn_report", "gmsh_gcn")}
     md = []
     machine = ""
     try:
@@ -222,6 +222,32 @@ def main():
               "dense grid, estimated element count change, Hausdorff / diagonal):\n")
     md.append(table(["model", "field", "faces", "size dev mean / p95 / max", "elements vs dense", "Hausdorff / diag"],
                     fields))
+
+    # GCN-ABGS against LBO-ABGS.
+    rows = []
+    for m, x in r.items():
+        rep, gr, g, gg = x["report"] or {}, x["gcn_report"] or {}, x["gmsh"], x["gmsh_gcn"]
+        if not gr or not g or not gg:
+            rows.append([m, "missing"] + ["–"] * 7)
+            continue
+        lbo_s = (rep.get("seconds") or {}).get("simplify")
+        gcn_s = gr["report"]["seconds"]
+        base = g["dense_triangles"]
+        for name, ev, secs, gm in (("LBO-ABGS", g, lbo_s, g), ("GCN-ABGS", gg, gcn_s, gg)):
+            p = "field_simplified_"
+            rows.append([m, name, int(ev["simplified_faces"]),
+                         f"{100 * (1 - ev['simplified_faces'] / ev['dense_faces']):.1f} %",
+                         f"{ev[p + 'size_dev_p95']:.3f} / {ev[p + 'size_dev_max']:.3f}",
+                         pct(ev[p + "elements_change"]), f"{100 * ev[p + 'hausdorff_rel']:.3f} %",
+                         num(secs, "{:.2f}") + (f" (×{lbo_s / gcn_s:.1f})" if name == "GCN-ABGS" and lbo_s and gcn_s else ""),
+                         f"{int(gm['simplified_triangles'])} ({pct(gm['simplified_triangles'] / base - 1, 1)} vs dense)"])
+    md.append("## GCN-ABGS against LBO-ABGS (same dense grid, defaults)\n")
+    md.append("Faces and reduction of the simplified grid; size deviation p95 / max, estimated element count "
+              "change and Hausdorff / diagonal against the dense grid (`abgs_evaluate`, the gmsh program's "
+              "field rows); simplify seconds (GCN: ×speed-up over LBO-ABGS); Gmsh triangles with the grid as "
+              "the size callback, against the dense grid's mesh.\n")
+    md.append(table(["model", "method", "faces", "reduction", "size dev p95 / max", "elements vs dense",
+                     "Hausdorff / diag", "simplify s", "Gmsh triangles"], rows))
 
     # Goals.
     rows = []

@@ -135,6 +135,13 @@ for m in "${models[@]}"; do
   run_prog decimation "$dir" "$bin/compare_decimation" "$dir/dense.vtk" "$dir/simplified.vtk" --samples "$samples"
   run_prog gmsh "$dir" "$bin/gmsh_mesh" "$step_file" --dense "$dir/dense.vtk" \
     --simplified "$dir/simplified.vtk" --stl "$stl" --samples "$samples"
+  # GCN-ABGS (the embedded model) on the same dense grid, defaults, and the
+  # same Gmsh program on its grid (dense and STL rows repeat as anchors).
+  printf -- '-- gcn\n'
+  "$abgs" simplify "$dir/dense.vtk" --method gcn -o "$dir/gcn.vtk" --report "$dir/gcn_report.json" 2>&1 | tail -1 \
+    || { echo "FAILED: gcn" >&2; failed+=("$m/gcn"); }
+  run_prog gmsh_gcn "$dir" "$bin/gmsh_mesh" "$step_file" --dense "$dir/dense.vtk" \
+    --simplified "$dir/gcn.vtk" --stl "$stl" --samples "$samples"
 done
 
 step "report"
