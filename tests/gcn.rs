@@ -76,8 +76,9 @@ fn dataset_targets_are_the_accurate_estimates_along_the_run() {
         .map(|i| snaps[0].target[i])
         .collect();
     assert_eq!(sorted_bits(got), sorted_bits(expect));
-    // Collapsible share falls along the run; few are left at the end (those
-    // whose collapse the mesh refuses, as the census reports them).
+    // Collapsible share falls along the run; none is left at convergence
+    // (the loop stops only when every edge was a candidate or is known not to
+    // be collapsible).
     let last = snaps.last().unwrap();
     let coll = |s: &abgs::gcn::dataset::Snapshot| {
         (0..s.graph.n_edges)

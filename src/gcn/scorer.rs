@@ -18,8 +18,10 @@
 //!    `verify`, the full accurate estimate instead, and edges it finds not
 //!    collapsible are dropped.
 //!
-//! The loop then applies the shared 1-ring filter and collapses. The loop
-//! ends when no edge is predicted below `T_score` or none passes the checks.
+//! An edge the checks refuse is not checked again until its neighbourhood
+//! changes. The loop then applies the shared 1-ring filter and collapses. The
+//! loop ends when no edge is predicted below `T_score` (or every such edge
+//! was refused and nothing around it changed).
 //!
 //! Cost per iteration: the features O(F + E + N·K), the model O(E·D² + N·K·D)
 //! for hidden width D, the checks O(C·valence²) for C ≤ pool edges (with
@@ -64,6 +66,10 @@ pub fn predicted_score(p: [f32; 2], h_loc: f64, allowance: f64, lim: &Limits) ->
 /// GCN-ABGS's scorer over a loaded model (see the module doc).
 pub struct Learned<'m> {
     model: &'m Model,
+    /// Per edge slot: the iteration whose checks refused it (0 = none); it
+    /// is not checked again until its neighbourhood changes.
+    refused: Vec<u32>,
+    ring: Vec<u32>,
     /// Seconds spent in the forward passes (features included).
     pub model_seconds: f64,
 }
@@ -73,6 +79,8 @@ impl<'m> Learned<'m> {
     pub fn new(model: &'m Model) -> Learned<'m> {
         Learned {
             model,
+            refused: Vec::new(),
+            ring: Vec::new(),
             model_seconds: 0.0,
         }
     }
@@ -107,32 +115,44 @@ impl<'m> Learned<'m> {
 impl EdgeScorer for Learned<'_> {
     fn rank(&mut self, view: &View) -> Result<Ranking> {
         let mesh = view.mesh;
+        if self.refused.len() < mesh.n_edges() {
+            self.refused.resize(mesh.n_edges(), 0);
+        }
         let y = self.predict(view)?;
         let p = view.params;
-        let mut order: Vec<(f64, u32)> = mesh
-            .edges()
-            .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED == 0)
-            .map(|e| (y[e as usize], e))
-            .filter(|&(s, _)| s < p.t_score)
-            .collect();
+        let mut order: Vec<(f64, u32)> = Vec::new();
+        for e in mesh.edges() {
+            if mesh.edge_flags[e as usize] & E_LOCKED != 0 || y[e as usize] >= p.t_score {
+                continue;
+            }
+            let made = self.refused[e as usize];
+            if made != 0 && view.stamps.unchanged(mesh, e, made, &mut self.ring) {
+                continue;
+            }
+            order.push((y[e as usize], e));
+        }
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let pool = (p.pool_factor * p.fraction * mesh.edge_count() as f64).ceil() as usize;
+        let exhausted = order.len() <= pool;
         order.truncate(pool);
         let exit_at = if p.verify { 0.5 } else { 0.0 };
         let checked: Vec<Estimate> = order
             .par_iter()
             .map(|&(_, e)| estimate::estimate(mesh, view.target, e, view.lim, exit_at))
             .collect();
-        let ranked = order
-            .iter()
-            .zip(checked)
-            .filter(|(_, est)| est.collapsible())
-            .map(|(&(_, e), est)| (e, est))
-            .collect();
+        let mut ranked = Vec::new();
+        for (&(_, e), est) in order.iter().zip(checked) {
+            if est.collapsible() {
+                ranked.push((e, est));
+            } else {
+                self.refused[e as usize] = view.iteration;
+            }
+        }
         Ok(Ranking {
             ranked,
             candidates: order.len(),
             estimated: order.len(),
+            exhausted,
         })
     }
 }

@@ -523,8 +523,13 @@ pub(crate) fn run_loop(
         rec.seconds = t.elapsed().as_secs_f64();
         report.iterations.push(rec);
         if rec.accepted == 0 {
-            report.stop = StopReason::Converged;
-            break;
+            if ranking.exhausted {
+                report.stop = StopReason::Converged;
+                break;
+            }
+            // Every candidate failed, but edges beyond the pool were not
+            // looked at: the next iteration does (the failed ones are known).
+            continue;
         }
         if let Some(cb) = progress.as_mut() {
             if !cb(&rec) {

@@ -63,6 +63,11 @@ pub struct Ranking {
     pub candidates: usize,
     /// Edges estimated or checked afresh this iteration.
     pub estimated: usize,
+    /// No edge left out of this ranking can be collapsible as far as the
+    /// scorer knows: every edge was either considered or is known not to be
+    /// collapsible. The loop ends on an iteration that collapses nothing
+    /// only when this holds; otherwise the next iteration looks further.
+    pub exhausted: bool,
 }
 
 /// A strategy that ranks the edges of one iteration (the seam between
@@ -172,6 +177,7 @@ impl EdgeScorer for Accurate {
             ranked,
             candidates: pool.len(),
             estimated: fresh.len(),
+            exhausted: pool.len() < pool_size || fresh.is_empty(),
         })
     }
 }
