@@ -19,6 +19,7 @@
 //! - [`sizing`]: curvature, proximity, sources, gradation and LBO of the size field.
 //! - [`simplify`]: LBO-ABGS, the sizing-aware simplifier (edge collapses).
 //! - [`qem`]: plain quadric-error decimation (the baseline simplifier).
+//! - [`gcn`]: GCN-ABGS, the learned edge scorer (an ONNX model run through `ort`).
 //! - [`ffi`]: the C ABI.
 //!
 //! ```
@@ -44,6 +45,7 @@
 
 pub mod error;
 pub mod ffi;
+pub mod gcn;
 pub mod geometry;
 pub mod io;
 pub mod mesh;
