@@ -43,6 +43,11 @@ pub enum Error {
     /// The grid has no triangles left (after dropping degenerate ones).
     #[error("empty grid: {0}")]
     Empty(String),
+    /// A learned model (GCN-ABGS, [`crate::gcn`]) is missing, corrupt, has the wrong
+    /// interface or gave unusable output, or its runtime failed. In C:
+    /// `ABGS_ERR_INVALID_ARGUMENT`, with a message that starts with "model:".
+    #[error("model: {0}")]
+    Model(String),
     /// A size query was made on a grid that carries no sizes.
     #[error("the grid has no sizes: set or compute them first")]
     NoSizes,

@@ -19,6 +19,7 @@
 //! - [`sizing`]: curvature, proximity, sources, gradation and LBO of the size field.
 //! - [`simplify`]: LBO-ABGS, the sizing-aware simplifier (edge collapses).
 //! - [`qem`]: plain quadric-error decimation (the baseline simplifier).
+//! - [`gcn`]: GCN-ABGS, the learned edge scorer (an ONNX model run through `ort`).
 //! - [`ffi`]: the C ABI.
 //!
 //! ```

@@ -127,6 +127,7 @@ impl From<Error> for FfiError {
             Error::UnsupportedFormat(_) => abgs_status::ABGS_ERR_UNSUPPORTED_FORMAT,
             Error::Empty(_) => abgs_status::ABGS_ERR_EMPTY,
             Error::NoSizes => abgs_status::ABGS_ERR_NO_SIZES,
+            Error::Model(_) => abgs_status::ABGS_ERR_INVALID_ARGUMENT,
         };
         FfiError(st, e.to_string())
     }

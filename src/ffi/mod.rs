@@ -20,6 +20,8 @@ mod boundary;
 mod grid;
 mod handle;
 mod metrics;
+#[cfg(feature = "onnxruntime")]
+pub(crate) mod onnxruntime;
 mod query;
 mod remesh;
 mod simplify;
