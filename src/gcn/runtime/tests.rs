@@ -391,13 +391,17 @@ fn onnxruntime_matches_stored_outputs_and_tract() {
     assert!(d <= 1e-4, "max |onnxruntime - tract| = {d:e}");
 }
 
-/// Timing on ~100k edges (N = 35k, K = 10); run with
+/// Timing on ~100k edges (N = 35k, K = 10) of the fixture, or of the model file named
+/// by `ABGS_GCN_MODEL`; run with
 /// `cargo test --release --lib gcn::runtime::tests::predict_time -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn predict_time_100k_edges() {
     let t0 = std::time::Instant::now();
-    let m = Model::from_bytes(FIXTURE).unwrap();
+    let m = match std::env::var_os("ABGS_GCN_MODEL") {
+        Some(p) => Model::from_file(Path::new(&p)).unwrap(),
+        None => Model::from_bytes(FIXTURE).unwrap(),
+    };
     let load = t0.elapsed();
     let g = grid_graph(187, 187, 10, 5);
     let mut times = Vec::new();
