@@ -12,13 +12,19 @@ Writes (next to the Rust runtime, src/gcn/testdata/):
   bad_mask_rank.onnx     valid ONNX, wrong interface: nbr_mask is [N,K,1]
   bad_output.onnx        valid ONNX, declares pred [E,T] but gives [E,3]: only a
                          run shows it
+  bad_dim_names.onnx     valid ONNX, runs on ONNX Runtime, but every input names its
+                         dynamic axes on its own (tract cannot unify them)
 
 Needs only onnx, numpy and (for the expected outputs) onnxruntime; the versions used:
     python3 -m venv /tmp/ortv
     /tmp/ortv/bin/pip install onnx==1.23.2 numpy==2.4.6 onnxruntime==1.31.1
     /tmp/ortv/bin/python training/make_fixture.py
 
-Model interface (all dims dynamic; the names N, E, K are shared between inputs):
+Model interface (all dims dynamic and named, one name each for N, E, K, shared by the
+inputs that have it: tract cannot unify two names for one size; with torch.onnx.export,
+dynamic_axes={"node_x": {0: "N"}, "edge_x": {0: "E"}, "edge_ends": {0: "E"},
+"nbr_node": {0: "N", 1: "K"}, "nbr_edge": {0: "N", 1: "K"}, "nbr_mask": {0: "N", 1: "K"},
+"pred": {0: "E"}}):
   node_x f32 [N,2], edge_x f32 [E,8], edge_ends i64 [E,2], nbr_node i64 [N,K],
   nbr_edge i64 [N,K], nbr_mask f32 [N,K]  ->  pred f32 [E,2] (non-negative)
 
@@ -43,7 +49,7 @@ D = 8  # hidden width: keeps the file a few KB
 SEED = 20240611
 
 
-def build_model(d=D, node_feats=2, out_cols=2, mask_rank3=False):
+def build_model(d=D, node_feats=2, out_cols=2, mask_rank3=False, own_dim_names=False):
     """The fixture (defaults), or a variant with a wrong interface for the tests."""
     D = d  # noqa: N806
     rng = np.random.default_rng(SEED)
@@ -126,6 +132,11 @@ def build_model(d=D, node_feats=2, out_cols=2, mask_rank3=False):
         helper.make_tensor_value_info("nbr_mask", f32, ["N", "K", 1] if mask_rank3 else ["N", "K"]),
     ]
     outputs = [helper.make_tensor_value_info("pred", f32, ["E", 2 if out_cols == 2 else "T"])]
+    if own_dim_names:
+        for i, vi in enumerate(inputs + outputs):
+            for d in vi.type.tensor_type.shape.dim:
+                if d.dim_param:
+                    d.dim_param = f"{d.dim_param}_{i}"
     graph = helper.make_graph(nodes, "gcn_abgs_fixture", inputs, outputs, inits)
     model = helper.make_model(
         graph, opset_imports=[helper.make_opsetid("", 17)], producer_name="abgs make_fixture.py"
@@ -181,6 +192,7 @@ def main():
         ("bad_node_features", dict(node_feats=3)),
         ("bad_mask_rank", dict(mask_rank3=True)),
         ("bad_output", dict(out_cols=3)),
+        ("bad_dim_names", dict(own_dim_names=True)),
     ]:
         onnx.save(build_model(d=2, **kw), os.path.join(OUT, name + ".onnx"))
 

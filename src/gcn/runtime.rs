@@ -72,14 +72,27 @@ pub const OUTPUT_NAME: &str = "pred";
 const ONNX_F32: i32 = 1;
 const ONNX_I64: i32 = 7;
 
-/// Each input: name, element type, and the fixed size of each dimension (`None`: dynamic).
-const INPUTS: [(&str, i32, &[Option<i64>]); 6] = [
-    ("node_x", ONNX_F32, &[None, Some(NODE_FEATURES as i64)]),
-    ("edge_x", ONNX_F32, &[None, Some(EDGE_FEATURES as i64)]),
-    ("edge_ends", ONNX_I64, &[None, Some(2)]),
-    ("nbr_node", ONNX_I64, &[None, None]),
-    ("nbr_edge", ONNX_I64, &[None, None]),
-    ("nbr_mask", ONNX_F32, &[None, None]),
+/// One declared dimension of the interface: a fixed size, or one of the graph's sizes
+/// N, E, K (index into [`SIZE_NAMES`]), which must be dynamic.
+#[derive(Clone, Copy)]
+enum Dim {
+    Fixed(i64),
+    Size(usize),
+}
+/// The graph's sizes, as the module doc calls them.
+const SIZE_NAMES: [&str; 3] = ["N", "E", "K"];
+const N: Dim = Dim::Size(0);
+const E: Dim = Dim::Size(1);
+const K: Dim = Dim::Size(2);
+
+/// Each input: name, element type, dimensions.
+const INPUTS: [(&str, i32, [Dim; 2]); 6] = [
+    ("node_x", ONNX_F32, [N, Dim::Fixed(NODE_FEATURES as i64)]),
+    ("edge_x", ONNX_F32, [E, Dim::Fixed(EDGE_FEATURES as i64)]),
+    ("edge_ends", ONNX_I64, [E, Dim::Fixed(2)]),
+    ("nbr_node", ONNX_I64, [N, K]),
+    ("nbr_edge", ONNX_I64, [N, K]),
+    ("nbr_mask", ONNX_F32, [N, K]),
 ];
 
 /// The inputs of one forward pass over a graph, row-major (see the module doc for the
@@ -236,7 +249,16 @@ fn setup(backend: Backend) -> std::result::Result<Runtime, String> {
                 )
                 .into(),
             };
-            let (api, version) = crate::ffi::onnxruntime::load_onnxruntime_api(&path)?;
+            let (api, version) =
+                crate::ffi::onnxruntime::load_onnxruntime_api(&path).map_err(|e| {
+                    match std::env::var_os(ORT_DYLIB_PATH_VAR) {
+                        Some(_) => e,
+                        None => format!(
+                            "{e} (set {ORT_DYLIB_PATH_VAR} to ONNX Runtime's shared library, e.g. \
+                             the onnxruntime wheel's onnxruntime/capi/libonnxruntime.so.1.31.1)"
+                        ),
+                    }
+                })?;
             (api, format!("ONNX Runtime {version} ({})", path.display()))
         }
     };
@@ -304,8 +326,12 @@ fn guarded<T>(
     }
 }
 
-/// Checks the ONNX file's declared interface (inputs, types, ranks, fixed sizes, the
-/// output) on its protobuf, before a backend parses the graph.
+/// Checks the ONNX file's declared interface on its protobuf, before a backend parses
+/// the graph: the six inputs and nothing else, their element types, ranks and fixed
+/// sizes, and the output. N, E and K must be dynamic and named (`dim_param`), each with
+/// one name used by every input that has it, the three names distinct: tract matches
+/// dimensions by name and cannot unify two names (a model with per-input names, as
+/// some exporters write by default, runs on ONNX Runtime but not on tract).
 fn check_interface(bytes: &[u8]) -> std::result::Result<(), String> {
     use tract_onnx::pb::{tensor_shape_proto::dimension, type_proto, ValueInfoProto};
     use tract_onnx::prelude::Framework;
@@ -315,14 +341,16 @@ fn check_interface(bytes: &[u8]) -> std::result::Result<(), String> {
             .map_err(|e| format!("not an ONNX model: {e:#}"))
     })?;
     let graph = proto.graph.as_ref().ok_or("the ONNX file has no graph")?;
-    // (element type, dimensions: Some(size) when fixed) of a declared value
-    let typed = |v: &ValueInfoProto| -> Option<(i32, Vec<Option<i64>>)> {
+    // element type and dimensions (Ok(size) | Err(name, "" if none)) of a declared value
+    type Dims = Vec<std::result::Result<i64, String>>;
+    let typed = |v: &ValueInfoProto| -> Option<(i32, Dims)> {
         let Some(type_proto::Value::TensorType(t)) = v.r#type.as_ref()?.value.as_ref() else {
             return None;
         };
-        let dims = t.shape.as_ref()?.dim.iter().map(|d| match d.value {
-            Some(dimension::Value::DimValue(x)) => Some(x),
-            _ => None,
+        let dims = t.shape.as_ref()?.dim.iter().map(|d| match &d.value {
+            Some(dimension::Value::DimValue(x)) => Ok(*x),
+            Some(dimension::Value::DimParam(p)) => Err(p.clone()),
+            None => Err(String::new()),
         });
         Some((t.elem_type, dims.collect()))
     };
@@ -341,6 +369,8 @@ fn check_interface(bytes: &[u8]) -> std::result::Result<(), String> {
             return Err(format!("unexpected input '{}'{hint}", v.name));
         }
     }
+    // the name each of N, E, K has in the file, and where it was first seen
+    let mut names: [Option<(String, &str)>; 3] = Default::default();
     for (name, ty, want) in INPUTS {
         let v = graph
             .input
@@ -357,24 +387,67 @@ fn check_interface(bytes: &[u8]) -> std::result::Result<(), String> {
                 want.len()
             ));
         }
-        for (axis, (got, want)) in dims.iter().zip(want.iter()).enumerate() {
-            if let (Some(w), Some(g)) = (want, got) {
-                if w != g {
+        for (axis, (got, want)) in dims.iter().zip(want).enumerate() {
+            match (want, got) {
+                (Dim::Fixed(w), Ok(g)) if w == *g => {}
+                (Dim::Fixed(w), _) => {
+                    let got = match got {
+                        Ok(g) => g.to_string(),
+                        Err(p) if p.is_empty() => "dynamic".to_string(),
+                        Err(p) => format!("dynamic '{p}'"),
+                    };
                     return Err(format!(
-                        "input '{name}' has size {g} on axis {axis}, expected {w}"
+                        "input '{name}' axis {axis} is {got}, expected the fixed size {w}"
                     ));
                 }
+                (Dim::Size(s), Ok(g)) => {
+                    return Err(format!(
+                        "input '{name}' axis {axis} ({}) is fixed to {g}; it must be dynamic",
+                        SIZE_NAMES[s]
+                    ))
+                }
+                (Dim::Size(s), Err(p)) if p.is_empty() => {
+                    return Err(format!(
+                        "input '{name}' axis {axis} ({}) has no name: name the dynamic \
+                         axes, one name each for N, E and K",
+                        SIZE_NAMES[s]
+                    ))
+                }
+                (Dim::Size(s), Err(p)) => match &names[s] {
+                    None => names[s] = Some((p.clone(), name)),
+                    Some((q, first)) if q != p => {
+                        return Err(format!(
+                            "{} is named '{q}' in input '{first}' but '{p}' in input \
+                             '{name}': tract needs one name per size",
+                            SIZE_NAMES[s]
+                        ))
+                    }
+                    Some(_) => {}
+                },
             }
         }
+    }
+    let named: Vec<&String> = names.iter().flatten().map(|(p, _)| p).collect();
+    if (1..named.len()).any(|i| named[..i].contains(&named[i])) {
+        return Err(format!("N, E and K need distinct names, not {named:?}"));
     }
     let out = graph
         .output
         .iter()
         .find(|v| v.name == OUTPUT_NAME)
         .ok_or_else(|| format!("no output '{OUTPUT_NAME}'"))?;
+    let e_name = names[1].as_ref().map(|(p, _)| p.as_str());
     match typed(out) {
-        Some((ONNX_F32, dims)) if dims.len() == 2 && matches!(dims[1], None | Some(2)) => Ok(()),
-        _ => Err(format!("output '{OUTPUT_NAME}' is not f32 [E, {TARGETS}]")),
+        Some((ONNX_F32, dims))
+            if dims.len() == 2
+                && matches!(&dims[0], Err(p) if p.is_empty() || Some(p.as_str()) == e_name)
+                && matches!(&dims[1], Ok(2) | Err(_)) =>
+        {
+            Ok(())
+        }
+        _ => Err(format!(
+            "output '{OUTPUT_NAME}' is not f32 [E, {TARGETS}] (with E named as in the inputs)"
+        )),
     }
 }
 

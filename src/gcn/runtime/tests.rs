@@ -11,6 +11,7 @@ const EXPECTED: &str = include_str!("../testdata/fixture_expected.json");
 const BAD_NODE_FEATURES: &[u8] = include_bytes!("../testdata/bad_node_features.onnx");
 const BAD_MASK_RANK: &[u8] = include_bytes!("../testdata/bad_mask_rank.onnx");
 const BAD_OUTPUT: &[u8] = include_bytes!("../testdata/bad_output.onnx");
+const BAD_DIM_NAMES: &[u8] = include_bytes!("../testdata/bad_dim_names.onnx");
 
 /// The fixture model, loaded once per test binary.
 fn fixture() -> &'static Model {
@@ -340,12 +341,76 @@ fn wrong_interface_is_an_error() {
     let msg = model_err(&replace(FIXTURE, b"pred", b"prex"));
     assert!(msg.contains("no output 'pred'"), "{msg}");
     let msg = model_err(BAD_NODE_FEATURES);
-    assert!(msg.contains("'node_x' has size 3 on axis 1"), "{msg}");
+    assert!(
+        msg.contains("'node_x' axis 1 is 3, expected the fixed size 2"),
+        "{msg}"
+    );
     let msg = model_err(BAD_MASK_RANK);
     assert!(msg.contains("'nbr_mask' is f32 of rank 3"), "{msg}");
     // declares pred [E, T]: only the trial run shows [E, 3]
     let msg = model_err(BAD_OUTPUT);
     assert!(msg.contains("trial run"), "{msg}");
+    // each input with its own names for N, E, K (runs on ONNX Runtime, not on tract)
+    let msg = model_err(BAD_DIM_NAMES);
+    assert!(msg.contains("tract needs one name per size"), "{msg}");
+}
+
+/// The fixture with its declared interface edited by `f`.
+fn edited(f: impl FnOnce(&mut tract_onnx::pb::GraphProto)) -> Vec<u8> {
+    use prost::Message;
+    let mut m = tract_onnx::pb::ModelProto::decode(FIXTURE).unwrap();
+    f(m.graph.as_mut().unwrap());
+    m.encode_to_vec()
+}
+
+/// The dimension `axis` of the declared value `name` (input or output).
+fn dim<'g>(
+    g: &'g mut tract_onnx::pb::GraphProto,
+    name: &str,
+    axis: usize,
+) -> &'g mut Option<tract_onnx::pb::tensor_shape_proto::dimension::Value> {
+    use tract_onnx::pb::type_proto::Value;
+    let v = g.input.iter_mut().chain(g.output.iter_mut());
+    let v = v.into_iter().find(|v| v.name == name).unwrap();
+    let Some(Value::TensorType(t)) = v.r#type.as_mut().unwrap().value.as_mut() else {
+        panic!()
+    };
+    &mut t.shape.as_mut().unwrap().dim[axis].value
+}
+
+#[test]
+fn dynamic_sizes_must_be_named_once() {
+    use tract_onnx::pb::tensor_shape_proto::dimension::Value::{DimParam, DimValue};
+    // the unedited round trip loads
+    Model::from_bytes(&edited(|_| {})).unwrap();
+    let msg = model_err(&edited(|g| *dim(g, "node_x", 0) = Some(DimValue(12))));
+    assert!(msg.contains("(N) is fixed to 12"), "{msg}");
+    let msg = model_err(&edited(|g| *dim(g, "nbr_edge", 1) = None));
+    assert!(msg.contains("(K) has no name"), "{msg}");
+    let msg = model_err(&edited(|g| {
+        *dim(g, "edge_ends", 0) = Some(DimParam("M".into()))
+    }));
+    assert!(
+        msg.contains("E is named 'E' in input 'edge_x' but 'M'"),
+        "{msg}"
+    );
+    let msg = model_err(&edited(|g| {
+        for (name, axis) in [("nbr_node", 1), ("nbr_edge", 1), ("nbr_mask", 1)] {
+            *dim(g, name, axis) = Some(DimParam("N".into()));
+        }
+    }));
+    assert!(msg.contains("distinct names"), "{msg}");
+    let msg = model_err(&edited(|g| *dim(g, "edge_x", 1) = Some(DimValue(7))));
+    assert!(msg.contains("expected the fixed size 8"), "{msg}");
+    let msg = model_err(&edited(|g| *dim(g, "pred", 0) = Some(DimParam("X".into()))));
+    assert!(msg.contains("output 'pred' is not f32 [E, 2]"), "{msg}");
+    // an initializer listed as an input (old exporters)
+    let msg = model_err(&edited(|g| {
+        let mut w = g.input[0].clone();
+        w.name = g.initializer[0].name.clone();
+        g.input.push(w);
+    }));
+    assert!(msg.contains("keep_initializers_as_inputs"), "{msg}");
 }
 
 #[test]
@@ -391,13 +456,17 @@ fn onnxruntime_matches_stored_outputs_and_tract() {
     assert!(d <= 1e-4, "max |onnxruntime - tract| = {d:e}");
 }
 
-/// Timing on ~100k edges (N = 35k, K = 10); run with
+/// Timing on ~100k edges (N = 35k, K = 10) of the fixture, or of the model file named
+/// by `ABGS_GCN_MODEL`; run with
 /// `cargo test --release --lib gcn::runtime::tests::predict_time -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn predict_time_100k_edges() {
     let t0 = std::time::Instant::now();
-    let m = Model::from_bytes(FIXTURE).unwrap();
+    let m = match std::env::var_os("ABGS_GCN_MODEL") {
+        Some(p) => Model::from_file(Path::new(&p)).unwrap(),
+        None => Model::from_bytes(FIXTURE).unwrap(),
+    };
     let load = t0.elapsed();
     let g = grid_graph(187, 187, 10, 5);
     let mut times = Vec::new();
