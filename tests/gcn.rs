@@ -133,3 +133,118 @@ fn dataset_file_reads_back() {
     assert!(trajectory(&g, &SimplifyParams::default(), &bad).is_err());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The vertices, triangles and sizes of a grid as bits.
+fn bits(g: &Grid) -> (Vec<[u64; 3]>, Vec<[u32; 3]>, Vec<u64>) {
+    (
+        g.vertices().iter().map(|p| p.map(f64::to_bits)).collect(),
+        g.triangles().to_vec(),
+        g.sizes().unwrap().iter().map(|h| h.to_bits()).collect(),
+    )
+}
+
+fn gcn_params(verify: bool) -> SimplifyParams {
+    SimplifyParams {
+        method: Method::Gcn,
+        verify,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn embedded_model_predictions_are_deterministic_and_non_negative() {
+    let g = sized_sphere(3);
+    let (mesh, _) = abgs::mesh::halfedge::HalfedgeMesh::from_grid(&g, None);
+    let mut mesh = mesh;
+    for v in 0..mesh.n_vertices() {
+        mesh.vertex_size[v] = g.sizes().unwrap()[mesh.vertex_origin[v] as usize];
+    }
+    let graph = abgs::gcn::features::graph(&mesh).unwrap();
+    let model = abgs::gcn::embedded_model().unwrap();
+    let a = model.predict(&graph.inputs).unwrap();
+    let b = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| model.predict(&graph.inputs).unwrap());
+    assert_eq!(a.len(), graph.inputs.n_edges);
+    assert_eq!(
+        a.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>(),
+        b.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>()
+    );
+    assert!(a.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
+}
+
+#[test]
+fn gcn_abgs_same_bits_on_one_and_two_threads() {
+    let g = sized_sphere(4);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| simplify(&g, &gcn_params(false), None).unwrap())
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(bits(&one.grid), bits(&two.grid));
+    assert_eq!(one.report.faces_out, two.report.faces_out);
+}
+
+#[test]
+fn gcn_abgs_simplifies_and_keeps_the_field() {
+    let g = sized_sphere(4);
+    let ep = abgs::metrics::EvalParams {
+        samples: 20_000,
+        hausdorff_samples: 20_000,
+        ..Default::default()
+    };
+    let lbo = simplify(&g, &SimplifyParams::default(), None).unwrap();
+    for verify in [false, true] {
+        let s = simplify(&g, &gcn_params(verify), None).unwrap();
+        let r = &s.report;
+        assert!(
+            r.faces_out < r.faces_in / 4,
+            "verify {verify}: {} faces",
+            r.faces_out
+        );
+        // A closed sphere stays a closed sphere (Euler characteristic 2).
+        let out = &s.grid;
+        let euler = out.vertices().len() as i64 - out.topology().edges.len() as i64
+            + out.triangles().len() as i64;
+        assert_eq!(euler, 2);
+        let e = abgs::metrics::evaluate(&g, out, &ep).unwrap();
+        assert!(
+            e.size_deviation.p95 < 1.25,
+            "verify {verify}: size deviation p95 {}",
+            e.size_deviation.p95
+        );
+        // Within a factor of two of LBO-ABGS's face count.
+        let ratio = r.faces_out as f64 / lbo.report.faces_out as f64;
+        assert!(
+            (0.5..2.0).contains(&ratio),
+            "verify {verify}: faces ratio {ratio}"
+        );
+    }
+}
+
+#[test]
+fn a_model_that_cannot_run_is_an_error() {
+    use abgs::gcn::{Learned, Model};
+    assert!(Model::from_bytes(b"not an onnx model").is_err());
+    let missing = std::env::temp_dir().join("abgs_no_such_model.onnx");
+    let e = Model::from_file(&missing).err().unwrap();
+    assert!(e.to_string().contains("abgs_no_such_model"), "{e}");
+    // A truncated copy of the embedded model.
+    let cut = &abgs::gcn::EMBEDDED_MODEL[..abgs::gcn::EMBEDDED_MODEL.len() / 2];
+    assert!(Model::from_bytes(cut).is_err());
+    // A good model still works through the seam.
+    let m = Model::from_bytes(abgs::gcn::EMBEDDED_MODEL).unwrap();
+    let s = abgs::simplify::simplify_with(
+        &sized_sphere(3),
+        &gcn_params(false),
+        &mut Learned::new(&m),
+        None,
+    )
+    .unwrap();
+    assert!(s.report.faces_out < s.report.faces_in);
+}

@@ -28,7 +28,8 @@
 //! Cost: the LBO-ABGS run plus, per snapshot, the exact estimate of every
 //! edge, O(E·S log F) (parallel; the same bits for any thread count).
 
-use super::features::{graph, GraphInputs};
+use super::features::graph;
+use super::runtime::GraphInputs;
 use super::scorer::edge_allowance;
 use crate::error::{Error, Result};
 use crate::mesh::halfedge::E_LOCKED;

@@ -34,79 +34,12 @@
 //! result does not depend on the thread count (per-element work collected
 //! in order; sums over the grid in a fixed order).
 
+use super::runtime::{GraphInputs, EDGE_FEATURES};
 use crate::error::{Error, Result};
 use crate::geometry::{add, cross, dot, norm, sub};
 use crate::mesh::halfedge::{HalfedgeMesh, NONE};
 use crate::sizing::lbo::vertex_lbo;
 use rayon::prelude::*;
-
-/// Node features per vertex.
-pub const NODE_FEATURES: usize = 2;
-/// Edge features per edge.
-pub const EDGE_FEATURES: usize = 8;
-
-/// One graph as the model takes it (row-major tensors, f32 and i64 as the
-/// ONNX model's inputs).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct GraphInputs {
-    /// Nodes `N` (live vertices).
-    pub n_nodes: usize,
-    /// Edges `E` (live edges).
-    pub n_edges: usize,
-    /// Neighbour slots per node `K` (the largest valence, at least 1).
-    pub k: usize,
-    /// `[N, 2]` node features.
-    pub node_x: Vec<f32>,
-    /// `[E, 8]` edge features.
-    pub edge_x: Vec<f32>,
-    /// `[E, 2]` node indices of each edge's ends.
-    pub edge_ends: Vec<i64>,
-    /// `[N, K]` neighbour node per slot (padding: the node itself).
-    pub nbr_node: Vec<i64>,
-    /// `[N, K]` edge index per slot (padding: 0).
-    pub nbr_edge: Vec<i64>,
-    /// `[N, K]` 1 for a real slot, 0 for padding.
-    pub nbr_mask: Vec<f32>,
-}
-
-impl GraphInputs {
-    /// Errors when a length disagrees with the counts, an index is out of
-    /// range, or a feature is not finite. O(N·K + E).
-    pub fn check(&self) -> Result<()> {
-        let (n, e, k) = (self.n_nodes, self.n_edges, self.k);
-        let bad = |what: &str| Err(Error::InvalidArgument(format!("model inputs: {what}")));
-        if self.node_x.len() != n * NODE_FEATURES
-            || self.edge_x.len() != e * EDGE_FEATURES
-            || self.edge_ends.len() != 2 * e
-            || self.nbr_node.len() != n * k
-            || self.nbr_edge.len() != n * k
-            || self.nbr_mask.len() != n * k
-        {
-            return bad("a tensor's length disagrees with N, E or K");
-        }
-        if self.edge_ends.iter().any(|&i| i < 0 || i as usize >= n)
-            || self.nbr_node.iter().any(|&i| i < 0 || i as usize >= n)
-        {
-            return bad("a node index is out of range");
-        }
-        if self
-            .nbr_edge
-            .iter()
-            .any(|&i| i < 0 || (i as usize >= e && i != 0))
-        {
-            return bad("an edge index is out of range");
-        }
-        if !self
-            .node_x
-            .iter()
-            .chain(&self.edge_x)
-            .all(|x| x.is_finite())
-        {
-            return bad("a feature is not finite");
-        }
-        Ok(())
-    }
-}
 
 /// The model's inputs for the live part of `mesh`, with the mesh edge of
 /// each graph edge and the mesh vertex of each node (both ascending).

@@ -10,13 +10,15 @@
 //!    edge ([`edge_allowance`]): the same formula as the accurate score, so
 //!    `T_size`, `β`, `κ` and `max_distance` stay run-time parameters;
 //! 3. edges with `ŷ < T_score`, lowest first (ties by edge index), at most
-//!    `pool_factor·n·|E|` of them, get the placement and validity checks of
-//!    the accurate estimate without its sampling
-//!    ([`crate::simplify::estimate::estimate`] with `exit_at = 0`: link
-//!    condition, feature rules, normal turn, largest angle, and the removed
-//!    vertex's exact distance to the new faces against the envelope); with
-//!    `verify`, the full accurate estimate instead, and edges it finds not
-//!    collapsible are dropped.
+//!    `pool_factor·n·|E|` of them, get a light exact check: the placement and
+//!    validity checks of the accurate estimate (link condition, feature
+//!    rules, normal turn, largest angle, the removed vertex's exact distance
+//!    to the new faces) and its size and distance test at one sample per new
+//!    triangle, the centroid ([`Limits::centroid_only`]), instead of a lattice
+//!    of at least 6; with `verify`, the full accurate estimate. Edges that
+//!    fail are dropped. (Without the centroid samples, confident mistakes of
+//!    the model at the end of a run went through: on occt_crankarm size
+//!    deviation max 3.4 and −9.8 % elements against LBO-ABGS's 1.24 and −1 %.)
 //!
 //! An edge the checks refuse is not checked again until its neighbourhood
 //! changes. The loop then applies the shared 1-ring filter and collapses. The
@@ -24,8 +26,8 @@
 //! was refused and nothing around it changed).
 //!
 //! Cost per iteration: the features O(F + E + N·K), the model O(E·D² + N·K·D)
-//! for hidden width D, the checks O(C·valence²) for C ≤ pool edges (with
-//! `verify`, O(C·S log F)). Deterministic: the model runs single-threaded on
+//! for hidden width D, the checks O(C·(valence² + valence·log F)) for C ≤
+//! pool edges (with `verify`, O(C·S log F)). Deterministic: the model runs single-threaded on
 //! inputs that do not depend on the thread count, the checks are collected
 //! in edge order.
 
@@ -135,10 +137,13 @@ impl EdgeScorer for Learned<'_> {
         let pool = (p.pool_factor * p.fraction * mesh.edge_count() as f64).ceil() as usize;
         let exhausted = order.len() <= pool;
         order.truncate(pool);
-        let exit_at = if p.verify { 0.5 } else { 0.0 };
+        let lim = Limits {
+            centroid_only: !p.verify,
+            ..*view.lim
+        };
         let checked: Vec<Estimate> = order
             .par_iter()
-            .map(|&(_, e)| estimate::estimate(mesh, view.target, e, view.lim, exit_at))
+            .map(|&(_, e)| estimate::estimate(mesh, view.target, e, &lim, 0.5))
             .collect();
         let mut ranked = Vec::new();
         for (&(_, e), est) in order.iter().zip(checked) {

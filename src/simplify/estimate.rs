@@ -29,6 +29,9 @@ pub struct Limits {
     /// Largest angle (degrees) a new triangle may have, unless the triangle
     /// it replaces already had a larger one.
     pub max_angle_deg: f64,
+    /// Sample each new triangle at its centroid only (GCN-ABGS's light
+    /// exact check of the model's choices) instead of the full lattice.
+    pub centroid_only: bool,
 }
 
 /// What keeps an edge from collapsing: the first check that failed, or for a
@@ -216,7 +219,9 @@ pub fn sample_fan(
             .map(|k| norm(sub(t.p[k], t.p[(k + 1) % 3])))
             .fold(0.0, f64::max);
         let h_min = t.h[0].min(t.h[1]).min(t.h[2]);
-        let n = if h_min > 0.0 && longest.is_finite() {
+        let n = if lim.centroid_only {
+            3
+        } else if h_min > 0.0 && longest.is_finite() {
             (2.0 * longest / h_min).ceil().clamp(5.0, 16.0) as usize
         } else {
             5
