@@ -74,7 +74,8 @@ int main(void) {
     CHECK_STATUS(abgs_simplify(dense, &p, &out, &r), ABGS_OK);
     CHECK(out != NULL);
     CHECK(r.faces_in == NT && r.vertices_in == NV);
-    CHECK(r.faces_out < NT / 2 && r.faces_out > 2);
+    /* a linear field on a square is exact on its two corner triangles */
+    CHECK(r.faces_out < NT / 2 && r.faces_out >= 2);
     CHECK(r.stop == ABGS_STOP_CONVERGED);
     CHECK(r.iterations >= 2 && (int)r.iterations == st.calls + 1); /* the last selected nothing */
     CHECK(r.corners == 4 && r.feature_lines >= 4);

@@ -469,7 +469,18 @@ pub(crate) fn run_loop(
         if let Some(obs) = observer.as_mut() {
             obs(&view)?;
         }
-        let ranking = scorer.rank(&view)?;
+        // An empty ranking that is not exhausted means every edge of this
+        // pool was found not collapsible: rank again, further on (those are
+        // now known), within the same iteration.
+        let mut ranking = scorer.rank(&view)?;
+        while ranking.ranked.is_empty() && !ranking.exhausted {
+            let more = scorer.rank(&view)?;
+            ranking = Ranking {
+                candidates: ranking.candidates + more.candidates,
+                estimated: ranking.estimated + more.estimated,
+                ..more
+            };
+        }
         let ranked_edges: Vec<u32> = ranking.ranked.iter().map(|x| x.0).collect();
         let limit = ((params.fraction * live as f64).floor() as usize).max(1);
         let chosen = select::disjoint_rings(&mesh, &ranked_edges, limit, &mut used);
@@ -524,13 +535,8 @@ pub(crate) fn run_loop(
         rec.seconds = t.elapsed().as_secs_f64();
         report.iterations.push(rec);
         if rec.accepted == 0 {
-            if ranking.exhausted {
-                report.stop = StopReason::Converged;
-                break;
-            }
-            // Every candidate failed, but edges beyond the pool were not
-            // looked at: the next iteration does (the failed ones are known).
-            continue;
+            report.stop = StopReason::Converged;
+            break;
         }
         if let Some(cb) = progress.as_mut() {
             if !cb(&rec) {

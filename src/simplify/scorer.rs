@@ -65,8 +65,9 @@ pub struct Ranking {
     pub estimated: usize,
     /// No edge left out of this ranking can be collapsible as far as the
     /// scorer knows: every edge was either considered or is known not to be
-    /// collapsible. The loop ends on an iteration that collapses nothing
-    /// only when this holds; otherwise the next iteration looks further.
+    /// collapsible. An empty ranking that does not hold this is asked for
+    /// again within the same iteration (the loop ends only on an empty,
+    /// exhausted ranking).
     pub exhausted: bool,
 }
 
