@@ -7,27 +7,15 @@ mod common;
 
 use abgs::gcn::dataset::{trajectory, write, DatasetParams, FORMAT};
 use abgs::simplify::{edge_scores, simplify, Method, SimplifyParams};
-use abgs::{BuildOptions, Grid};
+use abgs::Grid;
 use common::shapes::icosphere;
+use common::{euler, with_sizes};
 
 /// A sphere of radius 1 with a size field that varies over it.
 fn sized_sphere(level: usize) -> Grid {
-    let g = icosphere(1.0, level);
-    let h = g
-        .vertices()
-        .iter()
-        .map(|p| 0.08 + 0.06 * (1.0 + p[0]) + 0.02 * p[2] * p[2])
-        .collect();
-    Grid::from_arrays(
-        g.vertices().to_vec(),
-        g.triangles().to_vec(),
-        Some(h),
-        &BuildOptions {
-            weld_relative_tolerance: None,
-            orient: false,
-        },
-    )
-    .unwrap()
+    with_sizes(&icosphere(1.0, level), |p| {
+        0.08 + 0.06 * (1.0 + p[0]) + 0.02 * p[2] * p[2]
+    })
 }
 
 fn sorted_bits(mut v: Vec<[f32; 2]>) -> Vec<[u32; 2]> {
@@ -209,9 +197,7 @@ fn gcn_abgs_simplifies_and_keeps_the_field() {
         );
         // A closed sphere stays a closed sphere (Euler characteristic 2).
         let out = &s.grid;
-        let euler = out.vertices().len() as i64 - out.topology().edges.len() as i64
-            + out.triangles().len() as i64;
-        assert_eq!(euler, 2);
+        assert_eq!(euler(out), 2);
         let e = abgs::metrics::evaluate(&g, out, &ep).unwrap();
         assert!(
             e.size_deviation.p95 < 1.25,

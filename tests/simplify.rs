@@ -8,27 +8,9 @@ mod common;
 
 use abgs::geometry::{cross, dot, norm, sub};
 use abgs::simplify::{edge_scores, simplify, IterationRecord, SimplifyParams, StopReason};
-use abgs::{BuildOptions, Grid};
+use abgs::Grid;
 use common::shapes::{icosphere, Soup};
-
-/// `grid` with sizes `f(p)` at its vertices.
-fn with_sizes(grid: &Grid, f: impl Fn([f64; 3]) -> f64) -> Grid {
-    let h = grid.vertices().iter().map(|&p| f(p)).collect();
-    Grid::from_arrays(
-        grid.vertices().to_vec(),
-        grid.triangles().to_vec(),
-        Some(h),
-        &BuildOptions {
-            weld_relative_tolerance: None,
-            orient: false,
-        },
-    )
-    .unwrap()
-}
-
-fn euler(g: &Grid) -> i64 {
-    g.vertices().len() as i64 - g.topology().edges.len() as i64 + g.triangles().len() as i64
-}
+use common::{euler, with_sizes};
 
 /// Checks `out` against the dense `dense`: no degenerate face, each face's
 /// normal within 60° of the dense surface's there, same Euler characteristic

@@ -136,9 +136,8 @@ pub fn trajectory(
     let mut last_faces = usize::MAX;
     let mut observe = |view: &View| -> Result<()> {
         let faces = view.mesh.face_count();
-        let is_final = view.last;
         let due = faces as f64 <= next && snaps.len() + 1 < dp.snapshots;
-        if (due || is_final) && faces != last_faces {
+        if (due || view.last) && faces != last_faces {
             snaps.push(snapshot(view)?);
             last_faces = faces;
             while faces as f64 <= next {

@@ -26,3 +26,22 @@ pub fn linear_field(bmin: [f64; 3], diag: f64) -> impl Fn([f64; 3]) -> f64 + Syn
             + 0.2 * diag
     }
 }
+
+/// `grid` with sizes `f(p)` at its vertices.
+pub fn with_sizes(grid: &abgs::Grid, f: impl Fn([f64; 3]) -> f64) -> abgs::Grid {
+    let h = grid.vertices().iter().map(|&p| f(p)).collect();
+    abgs::Grid::from_arrays(
+        grid.vertices().to_vec(),
+        grid.triangles().to_vec(),
+        Some(h),
+        &abgs::BuildOptions {
+            weld_relative_tolerance: None,
+            orient: false,
+        },
+    )
+    .unwrap()
+}
+
+pub fn euler(g: &abgs::Grid) -> i64 {
+    g.vertices().len() as i64 - g.topology().edges.len() as i64 + g.triangles().len() as i64
+}
