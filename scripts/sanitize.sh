@@ -24,6 +24,8 @@ if [[ $what == all || $what == asan ]]; then
   RUSTFLAGS="-Zsanitizer=address" cargo +nightly build --quiet --lib --target "$host" --target-dir target/asan
   lib=target/asan/$host/debug
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:halt_on_error=1
+  # Third-party leaks only, each explained in the file.
+  export LSAN_OPTIONS=suppressions=$repo/scripts/lsan.supp:print_suppressions=1
   export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   failed=0
   for src in ffi_tests/*.c; do
