@@ -30,14 +30,8 @@ while (($#)); do
   shift
 done
 ((${#configs[@]})) || configs=("paper=--tau-d 0.05 --clearance 0" "default=")
-meshes=../shared/meshes
-if ((${#models[@]} == 0)); then
-  for f in "$meshes"/*.stl "$meshes"/*.obj "$meshes"/*.off; do
-    m=$(basename "${f%.*}")
-    case $m in trimesh_fm1_satellite|trimesh_cycloidal) ((big)) || continue ;; esac
-    models+=("$m")
-  done
-fi
+source bench/models.sh
+((${#models[@]})) || mapfile -t models < <(shared_models "$big")
 out=${ABGS_FIDELITY_DIR:-$repo/target/fidelity}
 mkdir -p "$out"
 cargo build --release -q -p abgs-cli
@@ -47,7 +41,7 @@ for c in "${configs[@]}"; do
   name=${c%%=*} args=${c#*=}
   names+=("$name")
   for m in "${models[@]}"; do
-    f=$(compgen -G "$meshes/$m.*" | grep -E '\.(stl|obj|off)$' | head -1)
+    f=$(model_file "$m")
     dir=$out/$name/$m
     mkdir -p "$dir"
     echo "== $name: $m" >&2

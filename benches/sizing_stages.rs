@@ -5,31 +5,12 @@
 //! `cargo bench --bench sizing_stages [-- MODEL...]`
 
 use abgs::sizing::{self, SizeParams};
-use abgs::{BuildOptions, Grid};
+use abgs::Grid;
 use std::path::PathBuf;
 
-/// Torus with radii (R, r) = (3, 1), `n` × `m` quads split in two.
-fn torus(n: usize, m: usize) -> Grid {
-    let (big, small) = (3.0, 1.0);
-    let mut v = Vec::new();
-    for i in 0..n {
-        let u = std::f64::consts::TAU * i as f64 / n as f64;
-        for j in 0..m {
-            let w = std::f64::consts::TAU * j as f64 / m as f64;
-            let rr = big + small * w.cos();
-            v.push([rr * u.cos(), rr * u.sin(), small * w.sin()]);
-        }
-    }
-    let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
-    let mut t = Vec::new();
-    for i in 0..n {
-        for j in 0..m {
-            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    Grid::from_arrays(v, t, None, &BuildOptions::default()).unwrap()
-}
+#[path = "../tests/common/shapes.rs"]
+mod shapes;
+use shapes::torus;
 
 fn report(name: &str, g: &Grid) {
     let p = SizeParams::default();

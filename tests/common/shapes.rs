@@ -253,3 +253,26 @@ pub fn add_grid(s: &mut Soup, g: &Grid) {
     s.v.extend_from_slice(g.vertices());
     s.t.extend(g.triangles().iter().map(|t| t.map(|i| i + o)));
 }
+
+/// Torus with radii (R, r) = (3, 1), `n` × `m` quads split in two
+/// (2·n·m triangles, closed, genus 1).
+pub fn torus(n: usize, m: usize) -> Grid {
+    let mut v = Vec::new();
+    for i in 0..n {
+        let u = std::f64::consts::TAU * i as f64 / n as f64;
+        for j in 0..m {
+            let w = std::f64::consts::TAU * j as f64 / m as f64;
+            let rr = 3.0 + w.cos();
+            v.push([rr * u.cos(), rr * u.sin(), w.sin()]);
+        }
+    }
+    let id = |i: usize, j: usize| ((i % n) * m + (j % m)) as u32;
+    let mut t = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    Grid::from_arrays(v, t, None, &BuildOptions::default()).unwrap()
+}
