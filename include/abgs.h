@@ -55,6 +55,8 @@
 
 // Method: GCN-ABGS, the learned simplifier (the embedded graph network
 // predicts every edge's errors in one pass; `t_score` and `verify` apply).
+// A library built without its `gcn` feature (on by default) answers
+// ABGS_ERR_INVALID_ARGUMENT with a message saying so.
 #define ABGS_METHOD_GCN 1
 
 // Why a simplification stopped (`abgs_simplify_report.stop`): nothing could

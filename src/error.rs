@@ -43,7 +43,7 @@ pub enum Error {
     /// The grid has no triangles left (after dropping degenerate ones).
     #[error("empty grid: {0}")]
     Empty(String),
-    /// A learned model (GCN-ABGS, [`crate::gcn`]) is missing, corrupt, has the wrong
+    /// A learned model (GCN-ABGS, `abgs::gcn`) is missing, corrupt, has the wrong
     /// interface or gave unusable output, or its runtime failed. In C:
     /// `ABGS_ERR_INVALID_ARGUMENT`, with a message that starts with "model:".
     #[error("model: {0}")]

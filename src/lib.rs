@@ -45,6 +45,7 @@
 
 pub mod error;
 pub mod ffi;
+#[cfg(feature = "gcn")]
 pub mod gcn;
 pub mod geometry;
 pub mod io;

@@ -124,7 +124,7 @@ fn with_cube(sized: bool, f: impl FnOnce(*mut abgs_grid) -> Outcome) -> Outcome 
 /// ABI, and checks the file is unchanged and a failure leaves `*out` NULL.
 fn load_bytes(ext: &str, bytes: &[u8]) -> Outcome {
     let dir = tmp_dir();
-    let path = dir.join(format!("case.{ext}"));
+    let path = dir.path().join(format!("case.{ext}"));
     std::fs::write(&path, bytes).unwrap();
     let o = load_path(&path);
     assert_eq!(
@@ -149,16 +149,12 @@ fn load_path(path: &std::path::Path) -> Outcome {
     o
 }
 
-fn tmp_dir() -> PathBuf {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let d = std::env::temp_dir().join(format!(
-        "abgs-bad-input-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh directory, removed with everything in it when dropped.
+fn tmp_dir() -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix("abgs-bad-input-")
+        .tempdir()
+        .unwrap()
 }
 
 /// A binary STL: 80-byte header, the stated count, then `actual` triangles.
@@ -445,13 +441,17 @@ fn cases() -> Vec<(
             "missing file",
             ABGS_ERR_IO,
             "no-such-file",
-            c(Box::new(|| load_path(&tmp_dir().join("no-such-file.stl")))),
+            c(Box::new(|| {
+                load_path(&tmp_dir().path().join("no-such-file.stl"))
+            })),
         ),
         (
             "a directory",
             ABGS_ERR_IO,
             "",
-            c(Box::new(|| load_path(&tmp_dir().join("d.stl").tap_mkdir()))),
+            c(Box::new(|| {
+                load_path(&tmp_dir().path().join("d.stl").tap_mkdir())
+            })),
         ),
         (
             "non-manifold fan (3 triangles on an edge) loads",

@@ -66,8 +66,11 @@ fn compile_and_run(source: &Path, out_dir: &Path, lib: &Path) {
 fn c_programs_pass() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let lib = lib_dir();
-    let out_dir = std::env::temp_dir().join(format!("abgs-ffi-tests-{}", std::process::id()));
-    std::fs::create_dir_all(&out_dir).unwrap();
+    let tmp = tempfile::Builder::new()
+        .prefix("abgs-ffi-tests-")
+        .tempdir()
+        .unwrap();
+    let out_dir = tmp.path().to_path_buf();
     let mut sources: Vec<PathBuf> = std::fs::read_dir(root.join("ffi_tests"))
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -78,5 +81,4 @@ fn c_programs_pass() {
     for s in &sources {
         compile_and_run(s, &out_dir, &lib);
     }
-    std::fs::remove_dir_all(&out_dir).ok();
 }

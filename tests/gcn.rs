@@ -2,6 +2,7 @@
 //! accurate estimate's own numbers), the embedded model through the `ort`
 //! API (deterministic, bad models refused), and the learned loop (same bits
 //! for any thread count, topology kept, sizes faithful).
+#![cfg(feature = "gcn")]
 
 mod common;
 

@@ -388,7 +388,7 @@ fn own_element_count(mesh: &HalfedgeMesh) -> f64 {
 
 /// Simplifies the target grid `grid` (which must carry sizes) by the
 /// method of `params.method`: LBO-ABGS (the accurate estimate) or GCN-ABGS
-/// (the embedded model; see [`crate::gcn`]). `progress` is called after every
+/// (the embedded model; see `abgs::gcn`, cargo feature `gcn`). `progress` is called after every
 /// iteration that collapsed something (not after the final one that found
 /// nothing); returning `false` stops the loop, leaving a valid grid. Errors on
 /// invalid parameters, a grid without sizes, or a model that cannot run.
@@ -402,11 +402,17 @@ pub fn simplify(
 ) -> Result<Simplified> {
     match params.method {
         Method::Lbo => simplify_with(grid, params, &mut Accurate::default(), progress),
+        #[cfg(feature = "gcn")]
         Method::Gcn => {
             let model = crate::gcn::embedded_model()?;
             let mut scorer = crate::gcn::Learned::new(model);
             simplify_with(grid, params, &mut scorer, progress)
         }
+        #[cfg(not(feature = "gcn"))]
+        Method::Gcn => Err(crate::error::Error::Model(
+            "GCN-ABGS is not in this build of the library (cargo feature `gcn`, on by default)"
+                .into(),
+        )),
     }
 }
 
