@@ -33,8 +33,11 @@ pub fn closed_ring(mesh: &HalfedgeMesh, e: u32, out: &mut Vec<u32>) {
 
 /// Greedy selection: walks `ranked` (edges in the order to prefer) and keeps
 /// an edge when its closed 1-ring shares no vertex with the closed 1-ring of
-/// an edge already kept, up to `limit` edges. `used` is scratch space with
-/// one flag per vertex slot, all false on entry and on return. O(Σ ring sizes).
+/// an edge already kept, up to `limit` edges. `used` has one flag per vertex
+/// slot: a vertex flagged on entry blocks every ring through it (GCN-ABGS's
+/// rounds pass the rings of edges already accepted that way); the function's
+/// own flags are cleared again on return, so `used` leaves as it came.
+/// O(Σ ring sizes).
 pub fn disjoint_rings(
     mesh: &HalfedgeMesh,
     ranked: &[u32],
