@@ -8,7 +8,7 @@
 #   3. the CLI (target/release/abgs) built if missing: the tests compare with it;
 #   4. FreeCAD 0.20 from Debian (apt-get install freecad) when freecadcmd is
 #      missing, and the abgs and gmsh==4.15.2 packages for its Python (Debian's
-#      python3) in target/freecad-site (pip --target; numpy is Debian's);
+#      python3) in the prefix target/freecad-site (numpy is Debian's);
 #   5. pytest python/tests, FreeCAD test included and required.
 # Usage: python/ci.sh [--no-freecad]   (--no-freecad: steps 4 and the FreeCAD
 # test left out). Prints the seconds of each step.
@@ -61,18 +61,20 @@ if ((freecad)); then
     lap "apt-get install freecad"
   fi
   rm -rf "$site"
-  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --target "$site" ./python gmsh==4.15.2
+  # --prefix, not --target: with --target pip drops the wheel's lib/ (libgmsh.so).
+  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --prefix "$site" ./python gmsh==4.15.2
+  site_packages=$(compgen -G "$site/lib/python3*/site-packages" | head -1)
   if ! /usr/bin/python3 -c 'import numpy' 2>/dev/null; then
-    "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --target "$site" numpy==2.4.6
+    "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --prefix "$site" numpy==2.4.6
   fi
   gmsh_lib=$(compgen -G "$site/lib/libgmsh.so*" | head -1 || true)
-  [[ -n $gmsh_lib ]] || { echo "no libgmsh.so* in $site after installing gmsh" >&2; exit 2; }
+  [[ -n $gmsh_lib ]] || { echo "no libgmsh.so* in $site/lib after installing gmsh" >&2; exit 2; }
   if ldd "$gmsh_lib" | grep -q 'not found'; then
     apt_install libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 \
       libfontconfig1 libx11-6 libgomp1
   fi
   lap "packages for FreeCAD's Python"
-  export ABGS_REQUIRE_FREECAD=1 ABGS_SITE="$repo/$site"
+  export ABGS_REQUIRE_FREECAD=1 ABGS_SITE="$repo/$site_packages"
 fi
 
 echo "== pytest python/tests"

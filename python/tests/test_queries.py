@@ -135,3 +135,23 @@ def test_sources_and_params(surface: abgs.Grid) -> None:
     rep = g.compute_sizes(hmax=d / 20, sources=[abgs.point_source(c, d / 500, d / 50)])
     assert rep.limited_by_source > 0
     assert g.size_at(c) <= d / 500 * (1 + 1e-12)
+
+
+def test_hausdorff(dense: abgs.Grid, coarse: abgs.Grid) -> None:
+    """hausdorff == evaluate's, and the larger of the two one-sided distances."""
+    h = abgs.hausdorff(dense, coarse, samples=20000, seed=3)
+    e = abgs.evaluate(dense, coarse, samples=1000, hausdorff_samples=20000, seed=3)
+    assert h == e.hausdorff > 0
+    ab = abgs.hausdorff(dense, coarse, samples=20000, seed=3, directed=True)
+    ba = abgs.hausdorff(coarse, dense, samples=20000, seed=3, directed=True)
+    assert h == max(ab, ba)
+
+
+def test_edge_scores(coarse: abgs.Grid) -> None:
+    """One score per edge; invalid edges score 1 with NaN estimates."""
+    s = coarse.edge_scores(method="lbo", t_size=1.2)
+    n = coarse.stats.edges
+    assert all(a.shape == (n,) for a in s.values())
+    assert np.all((s["y"] >= 0) & (s["y"] <= 1))
+    bad = ~s["valid"]
+    assert np.all(s["y"][bad] == 1) and np.all(np.isnan(s["ds"][bad]))

@@ -536,10 +536,7 @@ class Grid:
         Raises ``NoSizesError``, ``InvalidArgumentError`` / ``NonFiniteError``
         (parameters, an unknown method), ``BusyError``.
         """
-        if isinstance(method, str):
-            if method.lower() not in _METHODS:
-                raise error(ERR_INVALID_ARGUMENT, f"method: expected 'lbo' or 'gcn', got {method!r}")
-            method = _METHODS[method.lower()]
+        method = _method(method)
         values = dict(locals())
         values.pop("progress")
         p = _defaults(SimplifyParams, lib.abgs_simplify_params_default, values)
@@ -574,6 +571,8 @@ class Grid:
         unknown = set(params) - {n for n, _ in SimplifyParams._fields_} - {"method"}
         if unknown:
             raise error(ERR_INVALID_ARGUMENT, f"unknown parameters {sorted(unknown)}")
+        if "method" in params:
+            params["method"] = _method(params["method"])
         p = _defaults(SimplifyParams, lib.abgs_simplify_params_default, params)
         n = self._count(lib.abgs_grid_edge_count)
         ds, dd, y = (np.empty(n, dtype=np.float64) for _ in range(3))
@@ -588,6 +587,16 @@ class Grid:
             n,
         )
         return {"ds": ds, "dd": dd, "valid": valid.astype(bool), "y": y}
+
+
+def _method(method: str | int) -> int:
+    """The ABI's number of a simplification method: ``"lbo"``, ``"gcn"`` or an
+    int (passed on for the library to check)."""
+    if isinstance(method, str):
+        if method.lower() not in _METHODS:
+            raise error(ERR_INVALID_ARGUMENT, f"method: expected 'lbo' or 'gcn', got {method!r}")
+        return _METHODS[method.lower()]
+    return method
 
 
 def _trampoline(progress: Progress, raised: list[BaseException]) -> Callable[[Any, Any], int]:
