@@ -61,11 +61,12 @@ if ((freecad)); then
     lap "apt-get install freecad"
   fi
   rm -rf "$site"
-  # --prefix, not --target: with --target pip drops the wheel's lib/ (libgmsh.so).
-  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --prefix "$site" ./python gmsh==4.15.2
+  # --prefix, not --target: with --target pip drops the wheel's lib/ (libgmsh.so);
+  # --ignore-installed: else pip removes the venv's own abgs.
+  "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --ignore-installed --prefix "$site" ./python gmsh==4.15.2
   site_packages=$(compgen -G "$site/lib/python3*/site-packages" | head -1)
   if ! /usr/bin/python3 -c 'import numpy' 2>/dev/null; then
-    "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --prefix "$site" numpy==2.4.6
+    "$venv/bin/pip" install -q --disable-pip-version-check --no-deps --ignore-installed --prefix "$site" numpy==2.4.6
   fi
   gmsh_lib=$(compgen -G "$site/lib/libgmsh.so*" | head -1 || true)
   [[ -n $gmsh_lib ]] || { echo "no libgmsh.so* in $site/lib after installing gmsh" >&2; exit 2; }
