@@ -59,6 +59,8 @@ int main(void) {
     CHECK(near(e.size_deviation_p95, 1.0, 1e-14) && near(e.size_deviation_p99, 1.0, 1e-14));
     CHECK(e.size_deviation_samples == 20000);
     CHECK(e.wrong_sheet == 0.0);
+    CHECK(e.contact_reference.samples == 0 && e.contact_reference.share == 0.0);
+    CHECK(e.contact_candidate.samples == 0 && e.contact_candidate.max == 0.0);
     CHECK(e.hausdorff < 1e-15 && e.hausdorff_relative < 1e-15);
     CHECK(near(e.diagonal, sqrt(2.0), 1e-15));
     CHECK(fabs(e.element_count_change) < 1e-12);
@@ -95,6 +97,34 @@ int main(void) {
     abgs_evaluation e2 = {.struct_size = sizeof e2};
     CHECK_STATUS(abgs_evaluate(fine, doubled, &p, &e2), ABGS_OK);
     CHECK(e2.size_deviation_mean == e.size_deviation_mean && e2.element_count_candidate == e.element_count_candidate);
+
+    /* Two coincident plates as two bodies, one with twice the other's sizes:
+       every point lies on both, and their sizes differ by 100 % everywhere;
+       a query there reads the smaller (the tie rule). */
+    {
+        static double x2[6 * NVF], hh[2 * NVF];
+        static uint32_t t2[6 * NTF];
+        for (int i = 0; i < 3 * NVF; i++) x2[i] = x2[3 * NVF + i] = xf[i];
+        for (int i = 0; i < 3 * NTF; i++) {
+            t2[i] = tf[i];
+            t2[3 * NTF + i] = tf[i] + NVF;
+        }
+        for (int i = 0; i < NVF; i++) {
+            hh[i] = hf[i];
+            hh[NVF + i] = h2[i];
+        }
+        abgs_grid *pair = NULL;
+        CHECK_STATUS(abgs_grid_from_arrays(x2, 2 * NVF, t2, 2 * NTF, hh, &pair), ABGS_OK);
+        CHECK_STATUS(abgs_evaluate(pair, pair, &p, &e), ABGS_OK);
+        CHECK(e.contact_reference.share == 1.0 && e.contact_reference.samples == p.samples);
+        CHECK(near(e.contact_reference.p50, 1.0, 1e-12) && near(e.contact_reference.max, 1.0, 1e-12));
+        CHECK(e.contact_reference.over_10 == 1.0);
+        CHECK(e.contact_candidate.p95 == e.contact_reference.p95);
+        double q[3] = {0.3, 0.6, 0.0}, hq = 0.0;
+        CHECK_STATUS(abgs_query_size(pair, q, &hq), ABGS_OK);
+        CHECK(near(hq, 0.1 + 0.1 * 0.3, 1e-15));
+        CHECK_STATUS(abgs_grid_free(pair), ABGS_OK);
+    }
 
     /* Hausdorff: the plate lifted by 0.25 is 0.25 away either way. */
     double d = -1.0, d1 = -1.0, d2 = -1.0;

@@ -55,11 +55,20 @@ fn linear_field_exact_and_closest_point_brute_force() {
         let sizes: Vec<f64> = g.vertices().iter().map(|&p| f(p)).collect();
         assert!(sizes.iter().all(|&s| s > 0.0));
         g.set_sizes(sizes).unwrap();
+        // Where bodies touch, the tie rule (query module) reads the smallest
+        // body's size at that body's own closest point, at most 2·contact
+        // gap away: lower by at most |∇f| = √0.14 < 0.375 times that.
+        let tie = if g.topology().body_count > 1 {
+            0.375 * 2.0 * g.contact_gap()
+        } else {
+            0.0
+        };
+        let agrees = |s: f64, want: f64| s <= want + 1e-12 * want && s >= want - tie - 1e-12 * want;
 
-        // On the surface: exact to 1e-12 relative.
+        // On the surface: exact to 1e-12 relative (or lowered at a tie).
         for (_, p) in sampling::surface_points(&g, 10_000, 5) {
             let s = g.query_size(p).unwrap();
-            assert!((s - f(p)).abs() <= 1e-12 * f(p), "{name}: {s} vs {}", f(p));
+            assert!(agrees(s, f(p)), "{name}: {s} vs {}", f(p));
         }
 
         // Off the surface: equals the field at the brute-force closest point.
@@ -79,10 +88,7 @@ fn linear_field_exact_and_closest_point_brute_force() {
             assert_eq!(hit.triangle, best.1, "{name}: closest triangle at {p:?}");
             let expect = f(best.2);
             let s = g.query_size(p).unwrap();
-            assert!(
-                (s - expect).abs() <= 1e-12 * expect,
-                "{name}: {s} vs {expect} at {p:?}"
-            );
+            assert!(agrees(s, expect), "{name}: {s} vs {expect} at {p:?}");
         });
     }
 }

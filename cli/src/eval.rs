@@ -1,7 +1,7 @@
 //! `abgs eval`: a simplified grid (candidate) against the dense grid it came
 //! from (reference), with the metrics of [`abgs::metrics`].
 
-use abgs::metrics::{evaluate, AngleStats, EvalParams, Evaluation};
+use abgs::metrics::{evaluate, AngleStats, ContactAgreement, EvalParams, Evaluation};
 use abgs::Result;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -57,9 +57,18 @@ pub fn evaluation_json(e: &Evaluation) -> Value {
         "element_count_reference": e.element_count_reference,
         "element_count_candidate": e.element_count_candidate,
         "element_count_change": e.element_count_change,
+        "contact_reference": contact_json(&e.contact_reference),
+        "contact_candidate": contact_json(&e.contact_candidate),
         "angles_reference": angles_json(&e.angles_reference),
         "angles_candidate": angles_json(&e.angles_candidate),
         "seconds": e.seconds,
+    })
+}
+
+fn contact_json(c: &ContactAgreement) -> Value {
+    json!({
+        "share": c.share, "samples": c.samples, "p50": c.p50, "p95": c.p95,
+        "max": c.max, "over_10": c.over_10,
     })
 }
 
@@ -134,6 +143,22 @@ fn print_table(reference: &Path, candidate: &Path, e: &Evaluation) {
         "elements/cell   reference {:.2}   candidate {:.2}   (candidate's element count / faces)",
         e.elements_per_cell_reference, e.elements_per_cell
     );
+    let c = (&e.contact_reference, &e.contact_candidate);
+    if c.0.samples > 0 {
+        println!(
+            "contact         {:.2} % of the surface lies on two bodies; their sizes differ (max/min - 1) by",
+            100.0 * c.0.share
+        );
+        for (name, a) in [("reference", c.0), ("candidate", c.1)] {
+            println!(
+                "  {name:<10}   p50 {:.2} %   p95 {:.2} %   max {:.2} %   over 10 %: {:.2} % of them",
+                100.0 * a.p50,
+                100.0 * a.p95,
+                100.0 * a.max,
+                100.0 * a.over_10
+            );
+        }
+    }
     println!(
         "angles (deg)   {:>8} {:>8} {:>8} {:>9} {:>8} {:>8}",
         "min", "min p1", "min p5", "mean min", "max p99", "max"

@@ -211,6 +211,17 @@ fn print_summary(
     if let Some(q) = qem {
         row("qem", q);
     }
+    let c = (&e.contact_reference, &e.contact_candidate);
+    if c.0.samples > 0 {
+        eprintln!(
+            "contact   {:.2} % of the surface; sizes differ p95 {:.2} % max {:.2} % (dense), p95 {:.2} % max {:.2} % (simplified)",
+            100.0 * c.0.share,
+            100.0 * c.0.p95,
+            100.0 * c.0.max,
+            100.0 * c.1.p95,
+            100.0 * c.1.max
+        );
+    }
     eprintln!("total {total:.2} s");
 }
 

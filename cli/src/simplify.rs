@@ -39,6 +39,10 @@ pub struct LboArgs {
     /// the derived Δd ≤ ½·ln(T_size)·h / ln β (default: derived).
     #[arg(long)]
     pub tau_d: Option<f64>,
+    /// Largest size ratio where bodies touch (T_contact): touching bodies
+    /// agree within about its square.
+    #[arg(long, default_value_t = SimplifyParams::default().t_contact)]
+    pub t_contact: f64,
     /// Each side of a thin wall or gap may move at most this fraction of its
     /// width (κ; 0 turns the clearance term off).
     #[arg(long, default_value_t = SimplifyParams::default().clearance_fraction)]
@@ -73,6 +77,7 @@ impl LboArgs {
         SimplifyParams {
             fraction: self.fraction,
             t_size: self.t_size,
+            t_contact: self.t_contact,
             tau_d: self.tau_d,
             beta,
             clearance_fraction: if self.clearance > 0.0 {
@@ -124,7 +129,7 @@ pub fn params_json(p: &SimplifyParams) -> Value {
         "method": match p.method { LibMethod::Lbo => "lbo", LibMethod::Gcn => "gcn" },
         "t_score": p.t_score, "verify": p.verify,
         "fraction": p.fraction, "pool_factor": p.pool_factor, "t_size": p.t_size,
-        "tau_d": p.tau_d, "beta": p.beta,
+        "t_contact": p.t_contact, "tau_d": p.tau_d, "beta": p.beta,
         "clearance_fraction": if p.clearance_fraction.is_finite() { json!(p.clearance_fraction) } else { Value::Null },
         "max_distance": p.max_distance, "max_iterations": p.max_iterations,
         "feature_angle_deg": p.feature_angle_deg, "corner_angle_deg": p.corner_angle_deg,
@@ -167,6 +172,7 @@ pub fn report_json(s: &Simplified) -> Value {
             "free": r.binding.free, "topology": r.binding.topology, "feature": r.binding.feature,
             "degenerate": r.binding.degenerate, "normal_turn": r.binding.normal_turn,
             "max_angle": r.binding.max_angle, "size": r.binding.size,
+            "contact": r.binding.contact,
             "distance": r.binding.distance, "max_distance": r.binding.max_distance,
         },
         "iterations": iterations_json(&r.iterations),

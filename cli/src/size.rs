@@ -40,7 +40,8 @@ pub struct SizeArgs {
     /// Ignore proximity.
     #[arg(long)]
     pub no_proximity: bool,
-    /// Gaps narrower than this are contacts between touching parts, not gaps (default: hmin).
+    /// Bodies nearer than this touch (one size there, no gap size between them);
+    /// default n_gap·hmin between bodies, hmin for the walls of one body.
     #[arg(long)]
     pub contact_gap: Option<f64>,
     /// A user source: "point X Y Z SIZE RADIUS", "segment X1 Y1 Z1 X2 Y2 Z2 SIZE RADIUS"

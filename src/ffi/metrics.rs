@@ -42,6 +42,41 @@ pub struct abgs_angle_stats {
     pub mean_min: f64,
 }
 
+/// Where bodies touch (an assembly's coincident faces, a shaft in a bore): how
+/// far the touching bodies' interpolated sizes differ at points of the
+/// reference surface lying on two bodies at once (within the contact distance
+/// diagonal / 2000 of another body's face). The disagreement at such a point
+/// is `max h / min h − 1` over the bodies there. All zero for a single body.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct abgs_contact_agreement {
+    /// Share of the reference surface (by area) lying on two bodies.
+    pub share: f64,
+    /// Number of such sample points.
+    pub samples: u64,
+    /// Median disagreement.
+    pub p50: f64,
+    /// 95th percentile of the disagreement (nearest rank).
+    pub p95: f64,
+    /// Largest disagreement.
+    pub max: f64,
+    /// Share of the contact samples whose disagreement exceeds 0.1.
+    pub over_10: f64,
+}
+
+impl From<metrics::ContactAgreement> for abgs_contact_agreement {
+    fn from(c: metrics::ContactAgreement) -> Self {
+        abgs_contact_agreement {
+            share: c.share,
+            samples: c.samples as u64,
+            p50: c.p50,
+            p95: c.p95,
+            max: c.max,
+            over_10: c.over_10,
+        }
+    }
+}
+
 /// What `abgs_evaluate` measured: a candidate grid against its reference.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -95,6 +130,10 @@ pub struct abgs_evaluation {
     pub elements_per_cell: f64,
     /// element_count_reference / faces_reference.
     pub elements_per_cell_reference: f64,
+    /// Where bodies touch: the reference's bodies' agreement.
+    pub contact_reference: abgs_contact_agreement,
+    /// Where bodies touch: the candidate's bodies' agreement at the same points.
+    pub contact_candidate: abgs_contact_agreement,
 }
 
 versioned!(abgs_eval_params, 32, default_params());
@@ -218,6 +257,8 @@ pub unsafe extern "C" fn abgs_evaluate(
             wrong_sheet: e.size_deviation.wrong_sheet,
             elements_per_cell: e.elements_per_cell,
             elements_per_cell_reference: e.elements_per_cell_reference,
+            contact_reference: e.contact_reference.into(),
+            contact_candidate: e.contact_candidate.into(),
         };
         // SAFETY: checked above.
         unsafe { write_out(out_evaluation, &ev, "out_evaluation") }

@@ -18,7 +18,8 @@ pub struct abgs_hit {
     pub point: [f64; 3],
     /// Distance to the surface.
     pub distance: f64,
-    /// Interpolated size (NaN when the grid has no sizes).
+    /// Interpolated size, with the tie rule between bodies of
+    /// `abgs_query_size` (NaN when the grid has no sizes).
     pub size: f64,
 }
 
@@ -26,6 +27,14 @@ versioned!(abgs_hit, 72);
 
 /// Size at `point` (3 doubles): exact closest point on the grid, barycentric
 /// interpolation there. Expected O(log F).
+///
+/// Ties between bodies: where bodies of an assembly touch, a point within
+/// the contact gap `c` (diagonal / 2000) of the surface that has another
+/// body's face within `d + c` (`d` its distance to the closest face) gets
+/// the smallest of those bodies' sizes, each interpolated at that body's
+/// closest point (at most 4 bodies). Bodies farther apart than `2c` are never
+/// mixed. The same rule holds for hinted and batch queries; volume queries
+/// (a minimum over the surface) satisfy it by construction.
 /// Errors: NULL, NON_FINITE, NO_SIZES, BUSY (a mutation is running).
 ///
 /// # Safety

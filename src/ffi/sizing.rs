@@ -58,7 +58,9 @@ pub struct abgs_size_params {
     pub proximity: i32,
     /// 1 = grade the result (default 1).
     pub gradation: i32,
-    /// Gaps narrower than this are contacts, not gaps; 0 = hmin (default 0).
+    /// Bodies nearer than this touch (one size there, no gap size between
+    /// them); 0 = the default: n_gap·hmin between bodies, hmin for the walls
+    /// of one body (default 0).
     pub contact_gap: f64,
     /// `n_sources` user sources, or NULL.
     pub sources: *const abgs_size_source,

@@ -21,6 +21,12 @@ use crate::io::{Format, PointArray, SurfaceData};
 use crate::spatial::Bvh;
 use std::path::Path;
 
+/// Sheets closer than this fraction of the bounding-box diagonal are in
+/// contact (touching bodies, coincident faces), not apart: the sizing's
+/// default contact gap and `hmin` (1/2000), the queries' tie tolerance
+/// between bodies, and the metrics' contact distance.
+pub const CONTACT_FRACTION: f64 = 1.0 / 2000.0;
+
 /// How a grid is built from raw data.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BuildOptions {
@@ -361,6 +367,11 @@ impl Grid {
     /// Bounding box of the vertices.
     pub fn bbox(&self) -> Aabb {
         self.bbox
+    }
+    /// Distance below which two bodies are in contact:
+    /// [`CONTACT_FRACTION`] of the bounding-box diagonal. O(1).
+    pub fn contact_gap(&self) -> f64 {
+        self.bbox.diagonal() * CONTACT_FRACTION
     }
     /// What was found and repaired on input.
     pub fn report(&self) -> &ValidationReport {

@@ -17,6 +17,8 @@
 //! - **estimated element count** `(4/√3) ∫ h⁻² dA` over the reference surface by
 //!   the 7-point degree-5 triangle rule, with `h` from the reference itself and
 //!   from the candidate;
+//! - **contact agreement** of both grids: where bodies touch, how far their
+//!   sizes differ (see [`contact`]);
 //! - **angle statistics** of both grids.
 //!
 //! Every result is deterministic: the same bits whatever the rayon thread count
@@ -29,10 +31,12 @@ use crate::mesh::stats::percentile;
 use crate::mesh::Grid;
 use crate::sampling::surface_points;
 use crate::simplify::envelope::CONTACT_FRACTION;
+pub use contact::ContactAgreement;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+pub mod contact;
 mod sheets;
 #[cfg(test)]
 mod tests;
@@ -131,6 +135,11 @@ pub struct Evaluation {
     pub elements_per_cell: f64,
     /// `element_count_reference / faces_reference`: the same for the reference.
     pub elements_per_cell_reference: f64,
+    /// Where bodies touch: the reference's bodies' agreement.
+    pub contact_reference: ContactAgreement,
+    /// Where bodies touch: the candidate's bodies' agreement (at the same
+    /// contact samples of the reference).
+    pub contact_candidate: ContactAgreement,
     /// Angles of the reference.
     pub angles_reference: AngleStats,
     /// Angles of the candidate.
@@ -159,6 +168,9 @@ pub fn evaluate(reference: &Grid, candidate: &Grid, params: &EvalParams) -> Resu
     let element_count_reference = estimated_element_count(reference, None)?;
     let element_count_candidate = estimated_element_count(reference, Some(candidate))?;
     let hausdorff = hausdorff(reference, candidate, params.hausdorff_samples, params.seed);
+    let (at, drawn) = contact::contact_samples(reference, params.samples, params.seed);
+    let contact_reference = contact::agreement_at(reference, reference, &at, drawn);
+    let contact_candidate = contact::agreement_at(reference, candidate, &at, drawn);
     let diagonal = reference.bbox().diagonal();
     let (fr, fc) = (reference.triangles().len(), candidate.triangles().len());
     Ok(Evaluation {
@@ -176,6 +188,8 @@ pub fn evaluate(reference: &Grid, candidate: &Grid, params: &EvalParams) -> Resu
         element_count_change: element_count_candidate / element_count_reference - 1.0,
         elements_per_cell: element_count_candidate / fc as f64,
         elements_per_cell_reference: element_count_reference / fr as f64,
+        contact_reference,
+        contact_candidate,
         angles_reference: angle_stats(reference),
         angles_candidate: angle_stats(candidate),
         seconds: t0.elapsed().as_secs_f64(),

@@ -40,51 +40,78 @@ fn normal(g: &Grid, t: u32) -> [f64; 3] {
     cross(sub(b, a), sub(c, a))
 }
 
+/// The reference body of each candidate body: every candidate face's centroid
+/// votes, with its area, for the body of its closest reference face. A face
+/// lying at a contact (another reference body within the contact gap of its
+/// centroid) votes only when its body has no other votes: the bottom of a
+/// block on a plate is as close to the plate as to the block, and a finely
+/// graded contact face must not outvote a coarse body. O(F_c log F_r),
+/// parallel, deterministic (votes are summed per body in face order and ties
+/// go to the lower body number).
+pub(crate) fn body_map(reference: &Grid, candidate: &Grid) -> Vec<u32> {
+    let ct = candidate.topology();
+    let rt = reference.topology();
+    let v = candidate.vertices();
+    let gap = reference.contact_gap();
+    let several = rt.body_count > 1;
+    // (reference body, area, at a contact) per candidate face.
+    let votes: Vec<(u32, f64, bool)> = candidate
+        .triangles()
+        .par_iter()
+        .map(|tri| {
+            let [a, b, c] = tri.map(|i| v[i as usize]);
+            let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+            let area = 0.5 * norm(cross(sub(b, a), sub(c, a)));
+            let Some(hit) = reference.bvh().closest(m, None) else {
+                return (0, area, false);
+            };
+            let body = rt.face_body[hit.triangle as usize];
+            let shared = several
+                && reference
+                    .bvh()
+                    .closest_filtered_within(m, hit.closest.dist2.sqrt() + gap, |t| {
+                        rt.face_body[t as usize] != body
+                    })
+                    .is_some();
+            (body, area, shared)
+        })
+        .collect();
+    let nb = (rt.body_count as usize).max(1);
+    let mut clear = vec![vec![0.0f64; nb]; ct.body_count as usize];
+    let mut shared = clear.clone();
+    for (f, &(b, area, at_contact)) in votes.iter().enumerate() {
+        let tally = if at_contact { &mut shared } else { &mut clear };
+        // A degenerate face still counts, so a body never goes without votes.
+        tally[ct.face_body[f] as usize][b as usize] += area.max(f64::MIN_POSITIVE);
+    }
+    clear
+        .iter()
+        .zip(&shared)
+        .map(|(c, s)| {
+            let c = if c.iter().any(|&x| x > 0.0) { c } else { s };
+            let mut best = 0;
+            for (i, &n) in c.iter().enumerate() {
+                if n > c[best] {
+                    best = i;
+                }
+            }
+            best as u32
+        })
+        .collect()
+}
+
 /// Do unnormalised normals `n` and `m` face each other?
 fn facing_back(n: [f64; 3], m: [f64; 3]) -> bool {
     dot(n, m) < FACING_BACK * norm(n) * norm(m)
 }
 
 impl<'a> Sheets<'a> {
-    /// Matches the bodies (O(F_c log F_r), parallel, deterministic: votes are
-    /// counted per body and ties go to the lower body number).
+    /// Matches the bodies ([`body_map`]).
     pub(crate) fn new(reference: &'a Grid, candidate: &'a Grid, contact: f64) -> Sheets<'a> {
-        let ct = candidate.topology();
-        let rt = reference.topology();
-        let v = candidate.vertices();
-        let votes: Vec<u32> = candidate
-            .triangles()
-            .par_iter()
-            .map(|tri| {
-                let [a, b, c] = tri.map(|i| v[i as usize]);
-                let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
-                reference
-                    .bvh()
-                    .closest(m, None)
-                    .map_or(0, |h| rt.face_body[h.triangle as usize])
-            })
-            .collect();
-        let nb = rt.body_count as usize;
-        let mut count = vec![vec![0u32; nb.max(1)]; ct.body_count as usize];
-        for (f, &b) in votes.iter().enumerate() {
-            count[ct.face_body[f] as usize][b as usize] += 1;
-        }
-        let body_map = count
-            .iter()
-            .map(|c| {
-                let mut best = 0;
-                for (i, &n) in c.iter().enumerate() {
-                    if n > c[best] {
-                        best = i;
-                    }
-                }
-                best as u32
-            })
-            .collect();
         Sheets {
             reference,
             candidate,
-            body_map,
+            body_map: body_map(reference, candidate),
             contact,
         }
     }

@@ -1,9 +1,22 @@
 //! Size queries on a [`Grid`] (DESIGN §3.8).
 //!
 //! - **surface**: exact closest point on the grid, then barycentric interpolation
-//!   of the three vertex sizes of that triangle (never a mix across triangles or
-//!   bodies). Ties between equidistant triangles go to the lowest triangle index,
-//!   so the answer is a function of the point alone.
+//!   of the three vertex sizes of that triangle (never a mix across triangles).
+//!   Ties between equidistant triangles go to the lowest triangle index, so the
+//!   answer is a function of the point alone.
+//! - **ties between bodies**: where bodies of an assembly touch, a point lies
+//!   on two bodies at once and the mesh there must satisfy both. So when the
+//!   point lies on the surface (its distance `d` to the closest face is at
+//!   most `c` = [`Grid::contact_gap`], diagonal / 2000) and a face of another
+//!   body lies within `d + c` of it, the answer is the smallest of those
+//!   bodies' sizes, each interpolated at that body's own closest point.
+//!   Bodies that are apart are never mixed: a point on one body reads another
+//!   only when that one is within `2c` of it (a contact), and a point farther
+//!   than `c` from every surface reads its closest body alone. Deterministic
+//!   (a minimum), the same for plain, hinted and batch queries; it costs one
+//!   more bounded search per query near the surface of a grid of several
+//!   bodies and nothing on one body. Volume queries (a minimum over the whole
+//!   surface) satisfy it by construction.
 //! - **hinted**: the same answer, with the search bound seeded by a triangle the
 //!   caller kept from a nearby query (advancing fronts query neighbours).
 //! - **batch**: many points in parallel (rayon), each answer identical to the
@@ -31,9 +44,15 @@ pub struct QueryHit {
     pub point: [f64; 3],
     /// Distance from the query point to the surface.
     pub distance: f64,
-    /// Interpolated size (NaN when the grid has no sizes).
+    /// Interpolated size, lowered by the tie rule between bodies where
+    /// another body is as close (see the module doc; NaN when the grid has
+    /// no sizes).
     pub size: f64,
 }
+
+/// Most bodies one surface query reads at a contact (the nearest and up to
+/// three more within the tie tolerance).
+pub const MAX_TIED_BODIES: usize = 4;
 
 /// Points per rayon task in batch queries; consecutive points share hints.
 const BATCH_CHUNK: usize = 256;
@@ -54,7 +73,13 @@ impl Grid {
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;
         let size = match self.sizes() {
-            Some(s) => interpolate(t.map(|v| s[v as usize]), b),
+            Some(s) => self.smallest_at_contact(
+                p,
+                hit.triangle,
+                hit.closest.dist2,
+                interpolate(t.map(|v| s[v as usize]), b),
+                s,
+            ),
             None => f64::NAN,
         };
         Ok(QueryHit {
@@ -98,6 +123,56 @@ impl Grid {
                 }
                 Ok(())
             })
+    }
+
+    /// The tie rule between bodies (module doc): `size`, the size on the
+    /// closest triangle `tri` at squared distance `d2`, lowered, when
+    /// `√d2 ≤ contact_gap`, to the size of every other body with a face within
+    /// `√d2 + contact_gap` of `p` (at most [`MAX_TIED_BODIES`] bodies in all).
+    /// O(1) on one body or off the surface, O(log F) per body found otherwise.
+    fn smallest_at_contact(&self, p: [f64; 3], tri: u32, d2: f64, size: f64, s: &[f64]) -> f64 {
+        let topo = self.topology();
+        if topo.body_count < 2 {
+            return size;
+        }
+        let gap = self.contact_gap();
+        if d2 > gap * gap {
+            return size;
+        }
+        let own = topo.face_body[tri as usize];
+        self.other_bodies_within(p, own, d2.sqrt() + gap)
+            .iter()
+            .map(|&(t, b)| interpolate(self.triangles()[t as usize].map(|v| s[v as usize]), b))
+            .fold(size, f64::min)
+    }
+
+    /// The closest point of `p` on each body other than `own` with a face
+    /// within `reach` of `p`, as (triangle, barycentric coordinates): the
+    /// nearest such body first, then the nearest of the rest, and so on, up
+    /// to `MAX_TIED_BODIES − 1` bodies. The one search behind the tie rule,
+    /// the simplifier's agreed sizes and the interface pass. O(log F + k)
+    /// per body found (k faces within `reach`).
+    pub(crate) fn other_bodies_within(
+        &self,
+        p: [f64; 3],
+        own: u32,
+        reach: f64,
+    ) -> arrayvec::ArrayVec<(u32, [f64; 3]), { MAX_TIED_BODIES - 1 }> {
+        let body = &self.topology().face_body;
+        let mut seen = arrayvec::ArrayVec::<u32, MAX_TIED_BODIES>::new();
+        seen.push(own);
+        let mut found = arrayvec::ArrayVec::new();
+        while !seen.is_full() {
+            let Some(hit) = self
+                .bvh()
+                .closest_filtered_within(p, reach, |t| !seen.contains(&body[t as usize]))
+            else {
+                break;
+            };
+            found.push((hit.triangle, hit.closest.bary));
+            seen.push(body[hit.triangle as usize]);
+        }
+        found
     }
 
     pub(crate) fn require_sizes(&self) -> Result<()> {

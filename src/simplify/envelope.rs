@@ -79,7 +79,7 @@ pub const DEFAULT_CLEARANCE_FRACTION: f64 = 0.25;
 
 /// Gaps narrower than `diagonal · CONTACT_FRACTION` are contacts, not gaps:
 /// the sizing's default contact gap (its default `hmin`, diagonal / 2000).
-pub const CONTACT_FRACTION: f64 = crate::sizing::DEFAULT_HMIN_FRACTION;
+pub const CONTACT_FRACTION: f64 = crate::mesh::CONTACT_FRACTION;
 
 /// How the size-related term of the envelope is set.
 #[derive(Debug, Clone, Copy, PartialEq)]

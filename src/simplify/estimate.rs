@@ -18,6 +18,11 @@ use crate::mesh::shape::{reliable_normal, unit};
 pub struct Limits {
     /// Largest size ratio allowed (`T_size`, > 1).
     pub t_size: f64,
+    /// Largest size ratio allowed where bodies touch (`T_contact`, > 1): at
+    /// a point lying on two bodies each body follows the agreed size within
+    /// it, so the two agree within about `T_contact²` (see
+    /// [`super::target`]).
+    pub t_contact: f64,
     /// The size term of the distance envelope (see [`super::envelope`]).
     pub size_term: SizeTerm,
     /// The clearance term's fraction `κ` (∞: no clearance term).
@@ -54,6 +59,8 @@ pub enum Binding {
     MaxAngle,
     /// The sampled size ratio (`Δs ≥ T_size`).
     Size,
+    /// The sampled size ratio where bodies touch (`≥ T_contact`).
+    Contact,
     /// The distance envelope.
     Distance,
     /// The absolute distance limit.
@@ -122,6 +129,9 @@ pub struct Sampled {
     pub dd: f64,
     /// Largest distance relative to the envelope at its landing point.
     pub de: f64,
+    /// Largest size ratio, either way, at points lying on two bodies (1 when
+    /// none).
+    pub dc: f64,
 }
 
 impl Sampled {
@@ -130,6 +140,7 @@ impl Sampled {
         ds: 1.0,
         dd: 0.0,
         de: 0.0,
+        dc: 1.0,
     };
 
     /// Takes in a distance `d` with envelope `allow` there.
@@ -141,9 +152,20 @@ impl Sampled {
         }
     }
 
-    /// The score of what was found.
+    /// The score of what was found: [`score`] with the contact term
+    /// `(dc − 1)/(T_contact − 1)` beside the others.
     pub fn score(&self, lim: &Limits) -> f64 {
-        score(self.ds, self.de, self.dd, lim)
+        let y = score(self.ds, self.de, self.dd, lim);
+        if self.dc > 1.0 {
+            let c = 0.5 * (self.dc - 1.0) / (lim.t_contact - 1.0);
+            if c.is_nan() {
+                1.0
+            } else {
+                y.max(c.min(1.0))
+            }
+        } else {
+            y
+        }
     }
 
     /// The term that sets the score (`Free` when it is below ½).
@@ -157,6 +179,10 @@ impl Sampled {
         } else {
             0.0
         };
+        let k = (self.dc - 1.0) / (lim.t_contact - 1.0);
+        if k > a.max(self.de).max(c) {
+            return Binding::Contact;
+        }
         // NaN terms (an infinite size ratio) count as the size test.
         if a.is_nan() || a >= self.de.max(c) {
             Binding::Size
@@ -219,45 +245,94 @@ pub fn sample_fan(
             .map(|k| norm(sub(t.p[k], t.p[(k + 1) % 3])))
             .fold(0.0, f64::max);
         let h_min = t.h[0].min(t.h[1]).min(t.h[2]);
-        let n = if lim.centroid_only {
-            3
-        } else if h_min > 0.0 && longest.is_finite() {
+        let full = if h_min > 0.0 && longest.is_finite() {
             (2.0 * longest / h_min).ceil().clamp(5.0, 16.0) as usize
         } else {
             5
         };
-        let inv = 1.0 / n as f64;
-        for i in 1..n {
-            for j in 1..n - i {
-                let k = n - i - j;
-                let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
-                let p = add(add(scale(t.p[0], a), scale(t.p[1], b)), scale(t.p[2], c));
-                let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
-                let Some(hit) = target.on_patch(p, t.patch, *hint) else {
-                    return Sampled {
-                        ds: f64::INFINITY,
-                        dd: f64::INFINITY,
-                        de: f64::INFINITY,
-                    };
-                };
-                *hint = hit.index;
-                let r = if s_data > 0.0 && hit.size > 0.0 {
-                    (s_data / hit.size).max(hit.size / s_data)
-                } else {
-                    f64::INFINITY
-                };
-                let before = out;
-                out.ds = out.ds.max(r);
-                if hit.dist > 0.0 {
-                    out.distance(hit.dist, target.allowance(hit.index, hit.size, h_loc, lim));
-                }
-                if out != before && out.score(lim) >= exit_at {
+        let n = if lim.centroid_only { 3 } else { full };
+        match sample_triangle(target, t, n, h_loc, lim, exit_at, hint, &mut out) {
+            Lattice::Stop => return out,
+            // The light check's centroid lies on two bodies: the contact
+            // tolerance is tight, so the whole lattice is checked there.
+            Lattice::Contact if n < full => {
+                if let Lattice::Stop =
+                    sample_triangle(target, t, full, h_loc, lim, exit_at, hint, &mut out)
+                {
                     return out;
                 }
             }
+            _ => {}
         }
     }
     out
+}
+
+/// How sampling one triangle ended.
+enum Lattice {
+    /// Every sample taken, none on two bodies.
+    Done,
+    /// Every sample taken, some on two bodies.
+    Contact,
+    /// The score reached the exit value (or the target could not be reached).
+    Stop,
+}
+
+/// Samples triangle `t` on the barycentric lattice with `n` divisions (the
+/// interior points), folding what is found into `out`.
+#[allow(clippy::too_many_arguments)]
+fn sample_triangle(
+    target: &Target,
+    t: &FanTri,
+    n: usize,
+    h_loc: f64,
+    lim: &Limits,
+    exit_at: f64,
+    hint: &mut u32,
+    out: &mut Sampled,
+) -> Lattice {
+    let inv = 1.0 / n as f64;
+    let mut contact = false;
+    for i in 1..n {
+        for j in 1..n - i {
+            let k = n - i - j;
+            let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
+            let p = add(add(scale(t.p[0], a), scale(t.p[1], b)), scale(t.p[2], c));
+            let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
+            let Some(hit) = target.on_patch(p, t.patch, *hint) else {
+                *out = Sampled {
+                    ds: f64::INFINITY,
+                    dd: f64::INFINITY,
+                    de: f64::INFINITY,
+                    dc: f64::INFINITY,
+                };
+                return Lattice::Stop;
+            };
+            *hint = hit.index;
+            let r = if s_data > 0.0 && hit.size > 0.0 {
+                (s_data / hit.size).max(hit.size / s_data)
+            } else {
+                f64::INFINITY
+            };
+            let before = *out;
+            out.ds = out.ds.max(r);
+            if hit.contact {
+                contact = true;
+                out.dc = out.dc.max(r);
+            }
+            if hit.dist > 0.0 {
+                out.distance(hit.dist, target.allowance(hit.index, hit.size, h_loc, lim));
+            }
+            if *out != before && out.score(lim) >= exit_at {
+                return Lattice::Stop;
+            }
+        }
+    }
+    if contact {
+        Lattice::Contact
+    } else {
+        Lattice::Done
+    }
 }
 
 /// Checks a face that moves from corners `old` to `new`: non-degenerate, its
@@ -521,6 +596,7 @@ fn evaluate(
         found.ds = s.ds;
         found.dd = found.dd.max(s.dd);
         found.de = found.de.max(s.de);
+        found.dc = s.dc;
     }
     Estimate {
         valid: true,

@@ -3,6 +3,19 @@
 //! projection is exact (closest point through a BVH) and restricted to the
 //! patch or line the projected point belongs to, so a thin wall or a narrow
 //! gap never mixes sizes or geometry of its two sides.
+//!
+//! **Contacts.** Where bodies touch (coincident faces of an assembly, a shaft
+//! in a bore), a point of one body lies on another too, and the mesher reads
+//! whichever body its search meets first: the two must agree. So the target's
+//! size at a point is the *agreed* one, the smallest of the bodies there (the
+//! queries' tie rule): a projection onto body `A` that lands within the
+//! contact gap of another body's face takes the smaller of the two sizes and
+//! says so ([`Hit::contact`]), and the estimates hold such points to the
+//! contact tolerance `T_contact` instead of `T_size` (see
+//! [`super::estimate::Limits::t_contact`]). Both bodies then follow one field
+//! closely wherever they touch, whatever their triangles, and so agree with
+//! each other. Which target triangles come near another body is found once
+//! ([`contact_faces`], conservative), so the extra search is paid only there.
 
 use super::envelope::Envelope;
 use super::estimate::Limits;
@@ -20,8 +33,11 @@ pub struct Hit {
     pub index: u32,
     /// Distance from the query point.
     pub dist: f64,
-    /// Target size at the closest point (barycentric interpolation).
+    /// Target size at the closest point (barycentric interpolation), the
+    /// smaller of the bodies' at a contact.
     pub size: f64,
+    /// The point lies on another body too (within the contact gap).
+    pub contact: bool,
 }
 
 /// The target grid with its patches and feature lines.
@@ -38,6 +54,40 @@ pub struct Target<'a> {
     pub seg_sizes: &'a [[f64; 2]],
     /// Gradient and clearance per target triangle.
     pub envelope: &'a Envelope,
+    /// Per target triangle: another body's face may lie within the contact
+    /// gap of it (empty for a single body; see [`contact_faces`]).
+    pub contact: &'a [bool],
+}
+
+/// Per triangle of `grid`: does a face of another body come within the
+/// contact gap ([`Grid::contact_gap`]) of it? Conservative (a sphere around
+/// the triangle is tested), so a `false` is certain. Empty for a grid of one
+/// body. O(F log F), parallel.
+pub fn contact_faces(grid: &Grid) -> Vec<bool> {
+    use rayon::prelude::*;
+    let topo = grid.topology();
+    if topo.body_count < 2 {
+        return Vec::new();
+    }
+    let gap = grid.contact_gap();
+    let v = grid.vertices();
+    let body = &topo.face_body;
+    grid.triangles()
+        .par_iter()
+        .enumerate()
+        .map(|(f, tri)| {
+            let [a, b, c] = tri.map(|i| v[i as usize]);
+            let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+            let r = [a, b, c]
+                .iter()
+                .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
+                .fold(0.0, f64::max);
+            let own = body[f];
+            grid.bvh()
+                .closest_filtered_within(m, r + gap, |t| body[t as usize] != own)
+                .is_some()
+        })
+        .collect()
 }
 
 impl Target<'_> {
@@ -67,12 +117,39 @@ impl Target<'_> {
         let size = b[0] * self.sizes[t[0] as usize]
             + b[1] * self.sizes[t[1] as usize]
             + b[2] * self.sizes[t[2] as usize];
+        let (size, contact) = if self.contact.get(hit.triangle as usize) == Some(&true) {
+            self.agreed(hit.closest.point, hit.triangle, size)
+        } else {
+            (size, false)
+        };
         Some(Hit {
             point: hit.closest.point,
             index: hit.triangle,
             dist: hit.closest.dist2.sqrt(),
             size,
+            contact,
         })
+    }
+
+    /// The agreed size at point `q` of target triangle `tri` (size `size`
+    /// there): the smallest of the sizes of the bodies with a face within the
+    /// contact gap of `q`, each at its own closest point, and whether any
+    /// other body was found. O(log F) per body.
+    fn agreed(&self, q: [f64; 3], tri: u32, size: f64) -> (f64, bool) {
+        let own = self.grid.topology().face_body[tri as usize];
+        let others = self
+            .grid
+            .other_bodies_within(q, own, self.grid.contact_gap());
+        let best = others
+            .iter()
+            .map(|&(t, b)| {
+                let t = self.grid.triangles()[t as usize];
+                b[0] * self.sizes[t[0] as usize]
+                    + b[1] * self.sizes[t[1] as usize]
+                    + b[2] * self.sizes[t[2] as usize]
+            })
+            .fold(size, f64::min);
+        (best, !others.is_empty())
     }
 
     /// Closest point of `p` on feature line `line`. O(log S) typically.
@@ -86,6 +163,7 @@ impl Target<'_> {
             index: hit.triangle,
             dist: hit.closest.dist2.sqrt(),
             size,
+            contact: false,
         })
     }
 

@@ -25,7 +25,7 @@ use std::time::Instant;
 
 /// Default `hmin` as a fraction of the bounding-box diagonal (1/2000); also
 /// the default contact gap: sheets closer than this are in contact, not a gap.
-pub const DEFAULT_HMIN_FRACTION: f64 = 1.0 / 2000.0;
+pub const DEFAULT_HMIN_FRACTION: f64 = crate::mesh::CONTACT_FRACTION;
 
 /// Most rounds of (share sizes at contacts, grade again) after the first gradation.
 const CONTACT_ROUNDS: usize = 4;
@@ -77,10 +77,12 @@ pub struct SizeParams {
     pub gradation: Option<Gradation>,
     /// User sources.
     pub sources: Vec<SizeSource>,
-    /// Gaps narrower than this are contacts (touching parts, tessellation noise
-    /// between coincident curved faces), not gaps; `None` = hmin. A gap below
-    /// hmin cannot be resolved by the field anyway. Where two bodies touch,
-    /// both take the smaller of their sizes (see [`contact`]).
+    /// Bodies nearer than this touch (a gap the field cannot resolve, and the
+    /// tessellation noise between coincident faces tessellated apart): where
+    /// they touch both take the smaller of their sizes (see [`contact`]) and
+    /// no gap size is set between them. `None` = `n_gap · hmin` for another
+    /// body (a narrower gap would need elements below hmin) and hmin for
+    /// the walls of one body; a value given applies to both.
     pub contact_gap: Option<f64>,
 }
 
@@ -254,10 +256,18 @@ pub fn compute(grid: &Grid, params: &SizeParams) -> Result<SizeFields> {
     };
     report.seconds_curvature = t.elapsed().as_secs_f64();
 
-    let contact_gap = params.contact_gap.unwrap_or(hmin).max(1e-12 * diag);
+    // Rays ignore hits nearer than `ray_min` (hmin: tessellation noise);
+    // another body nearer than `contact_gap` (n_gap·hmin: a gap the field
+    // cannot resolve, what coincident faces tessellated apart look like)
+    // touches this one (see `proximity` and `contact`).
+    let ray_min = params.contact_gap.unwrap_or(hmin).max(1e-12 * diag);
+    let contact_gap = params
+        .contact_gap
+        .unwrap_or(params.n_gap * hmin)
+        .max(ray_min);
     let t = Instant::now();
     let h_prox: Vec<f64> = if params.proximity {
-        let g = proximity::gaps(grid, &normals, contact_gap, hmax * params.n_gap);
+        let g = proximity::gaps(grid, &normals, ray_min, contact_gap, hmax * params.n_gap);
         g.into_iter().map(|g| g / params.n_gap).collect()
     } else {
         vec![f64::INFINITY; nv]

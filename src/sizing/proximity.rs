@@ -8,6 +8,21 @@
 //! edge-on). Ignored: the vertex's own faces, hits closer than the contact gap
 //! (touching bodies, and the tessellation noise between coincident curved faces:
 //! a conformal interface, not a gap), and hits beyond `max_gap`. The gap is the smallest such distance.
+//!
+//! **Gaps to another body the field cannot resolve.** Sizing asks for
+//! `n_gap` elements across a gap, so a gap narrower than `n_gap · hmin`
+//! would need elements below `hmin` and gets `hmin` at best: the field cannot
+//! resolve it. Between two *bodies* such a gap is also what independently
+//! tessellated coincident faces look like: two faceted cylinders of one
+//! radius (a shaft in its bore) stand apart by anything from 0 to the facets'
+//! sagitta `r·(1 − cos(π/n))` (0.14 mm for r = 4 mm and 12 facets, twice the
+//! bracket assembly's contact gap), so the distance flickers across the
+//! contact gap from vertex to vertex, and sizes would jump between the
+//! contact's and `hmin` along the interface. [`gaps`] therefore ignores
+//! another body's faces nearer than `unresolved` (sizing passes
+//! `n_gap · hmin`): at the field's resolution the two bodies touch there, and
+//! the contact rule ([`super::contact`]) gives them one size. A thin wall or
+//! slot of one body is not affected.
 
 use super::normals::PatchNormals;
 use crate::geometry::*;
@@ -17,10 +32,17 @@ use rayon::prelude::*;
 /// Cosine below which a hit face counts as facing back.
 pub(crate) const FACING_BACK: f64 = -0.2;
 
-/// Smallest gap per vertex (`+inf` where no opposite wall lies within `max_gap`).
+/// Smallest gap per vertex (`+inf` where no opposite wall lies within `max_gap`),
+/// another body's faces nearer than `unresolved` left out (module doc).
 /// O(V log F), parallel over vertices.
-pub fn gaps(grid: &Grid, normals: &PatchNormals, contact_gap: f64, max_gap: f64) -> Vec<f64> {
-    gaps_with(grid, normals, contact_gap, |_| max_gap, false)
+pub fn gaps(
+    grid: &Grid,
+    normals: &PatchNormals,
+    contact_gap: f64,
+    unresolved: f64,
+    max_gap: f64,
+) -> Vec<f64> {
+    gaps_with(grid, normals, contact_gap, unresolved, |_| max_gap, false)
 }
 
 /// Clearance per vertex: [`gaps`] with a limit per vertex (`limit[v]`: rays
@@ -35,13 +57,14 @@ pub fn clearances(
     contact_gap: f64,
     limit: &[f64],
 ) -> Vec<f64> {
-    gaps_with(grid, normals, contact_gap, |v| limit[v], true)
+    gaps_with(grid, normals, contact_gap, contact_gap, |v| limit[v], true)
 }
 
 fn gaps_with(
     grid: &Grid,
     normals: &PatchNormals,
     contact_gap: f64,
+    unresolved: f64,
     max_gap: impl Fn(usize) -> f64 + Sync,
     other_bodies: bool,
 ) -> Vec<f64> {
@@ -75,10 +98,12 @@ fn gaps_with(
                 }
                 for dir in [scale(n, -1.0), n] {
                     let limit = best.min(max_gap);
-                    let hit = bvh.first_hit(v[vi], dir, contact_gap, limit, |tri, _| {
+                    let hit = bvh.first_hit(v[vi], dir, contact_gap, limit, |tri, t| {
+                        let other = Some(topo.face_body[tri as usize]) != body;
                         own.binary_search(&tri).is_err()
+                            && !(other && t < unresolved)
                             && (dot(n, normals.face_normal[tri as usize]) < FACING_BACK
-                                || (other_bodies && Some(topo.face_body[tri as usize]) != body))
+                                || (other_bodies && other))
                     });
                     if let Some((_, t)) = hit {
                         best = best.min(t);

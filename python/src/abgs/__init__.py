@@ -32,6 +32,7 @@ from ._ffi import (
     STOP_CONVERGED,
     STOP_MAX_ITERATIONS,
     AngleStats,
+    ContactAgreement,
     EvalParams,
     Evaluation,
     GridStats,
@@ -129,6 +130,7 @@ def _with_both(a: Grid, b: Grid, call: Any) -> None:
 __all__ = [
     "AbgsError",
     "AngleStats",
+    "ContactAgreement",
     "BusyError",
     "EmptyError",
     "EvalParams",

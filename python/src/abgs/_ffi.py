@@ -164,6 +164,22 @@ class AngleStats(_PlainStruct):
     ]
 
 
+class ContactAgreement(_PlainStruct):
+    """Where bodies touch, how far their sizes differ (``abgs_contact_agreement``):
+    ``share`` (of the reference surface lying on two bodies), ``samples``,
+    ``p50``, ``p95``, ``max`` (of ``max h / min h − 1``) and ``over_10`` (share
+    of the contact samples above 10 %)."""
+
+    _fields_ = [
+        ("share", c_double),
+        ("samples", c_uint64),
+        ("p50", c_double),
+        ("p95", c_double),
+        ("max", c_double),
+        ("over_10", c_double),
+    ]
+
+
 class Evaluation(_Struct):
     """A candidate grid measured against its reference (``abgs_evaluation``).
 
@@ -176,8 +192,9 @@ class Evaluation(_Struct):
     (``element_count_reference``, ``element_count_candidate``,
     ``element_count_change``), ``angles_reference`` / ``angles_candidate``
     (``AngleStats``), ``seconds``, ``wrong_sheet`` (share of samples answered
-    from another body or a face turned away), ``elements_per_cell`` and
-    ``elements_per_cell_reference``.
+    from another body or a face turned away), ``elements_per_cell``,
+    ``elements_per_cell_reference``, and ``contact_reference`` /
+    ``contact_candidate`` (``ContactAgreement``: where bodies touch).
     """
 
     _fields_ = [
@@ -204,6 +221,8 @@ class Evaluation(_Struct):
         ("wrong_sheet", c_double),
         ("elements_per_cell", c_double),
         ("elements_per_cell_reference", c_double),
+        ("contact_reference", ContactAgreement),
+        ("contact_candidate", ContactAgreement),
     ]
 
 
@@ -310,6 +329,7 @@ class SimplifyParams(_Struct):
         ("clearance_fraction", c_double),
         ("t_score", c_double),
         ("verify", c_uint32),
+        ("t_contact", c_double),
     ]
 
 
@@ -409,6 +429,7 @@ STRUCTS: dict[str, type[ctypes.Structure]] = {
     "abgs_grid_stats": GridStats,
     "abgs_eval_params": EvalParams,
     "abgs_angle_stats": AngleStats,
+    "abgs_contact_agreement": ContactAgreement,
     "abgs_evaluation": Evaluation,
     "abgs_hit": Hit,
     "abgs_remesh_params": RemeshParams,

@@ -500,6 +500,7 @@ class Grid:
         fraction: float | None = None,
         pool_factor: float | None = None,
         t_size: float | None = None,
+        t_contact: float | None = None,
         tau_d: float | None = None,
         max_distance: float | None = None,
         max_iterations: int | None = None,
@@ -522,7 +523,8 @@ class Grid:
 
         ``method``: ``"lbo"`` (LBO-ABGS, default) or ``"gcn"`` (GCN-ABGS, the
         embedded model; ``t_score`` 0.5 and ``verify`` apply). Defaults:
-        fraction 0.10, pool_factor 2, tau_d 0 (derived envelope),
+        fraction 0.10, pool_factor 2, t_contact 1.2 (where bodies touch; lower makes touching bodies' own fields agree, at a cost in faces),
+        tau_d 0 (derived envelope),
         max_distance 0 (none), max_iterations 200, feature and corner angle
         30°, normal turn 60°, max angle 150°, repair on, beta 1.2,
         clearance_fraction 0.25.
