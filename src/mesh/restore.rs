@@ -162,18 +162,22 @@ impl Grid {
             )));
         }
         let report = history.to_report(vertices.len(), triangles.len())?;
-        let topology = Topology::build(vertices.len(), &triangles);
+        // The adjacency and the hierarchy are independent: side by side.
+        let (topology, bvh) = rayon::join(
+            || Topology::build(vertices.len(), &triangles),
+            || match bvh {
+                Some(layout) => Bvh::from_layout(&vertices, &triangles, layout)
+                    .map_err(|e| Error::InvalidArgument(format!("BVH layout: {e}"))),
+                None => Ok(Bvh::build(&vertices, &triangles)),
+            },
+        );
+        let bvh = bvh?;
         if report.non_orientable_bodies > topology.body_count as usize {
             return Err(Error::InvalidArgument(format!(
                 "input history: {} non-orientable bodies of {}",
                 report.non_orientable_bodies, topology.body_count
             )));
         }
-        let bvh = match bvh {
-            Some(layout) => Bvh::from_layout(&vertices, &triangles, layout)
-                .map_err(|e| Error::InvalidArgument(format!("BVH layout: {e}")))?,
-            None => Bvh::build(&vertices, &triangles),
-        };
         Ok(Grid::assemble(
             Checked {
                 vertices,
