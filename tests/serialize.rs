@@ -134,6 +134,14 @@ fn round_trip_is_bit_identical_on_shared_models() {
         g.save(&path).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), bytes);
         assert_same(&g, &Grid::load(&path).unwrap(), 500);
+        // Another kind of file under the name: refused after its first bytes.
+        let stl = common::shared_meshes().join("gmsh_t20_component8.stl");
+        std::fs::copy(stl, &path).unwrap();
+        let e = Grid::load(&path).unwrap_err();
+        assert!(e.to_string().contains("not an abgs grid"), "{e}");
+        std::fs::write(&path, &bytes[..5]).unwrap();
+        let e = Grid::load(&path).unwrap_err();
+        assert!(e.to_string().contains("truncated"), "{e}");
     }
 }
 
@@ -376,10 +384,12 @@ fn random_edits_give_an_error_or_a_correct_grid() {
                 let fresh = Grid::from_parts(g.to_parts(false)).unwrap();
                 for p in [[0.3, 0.1, 0.2], [3.5, -0.2, 0.4], [0.0, 0.0, 3.0]] {
                     assert_eq!(g.closest(p, None).unwrap(), fresh.closest(p, None).unwrap());
-                    assert_eq!(
-                        g.query_volume(p, 1.3).unwrap(),
-                        fresh.query_volume(p, 1.3).unwrap()
-                    );
+                    // To rounding only: the two trees scan different triangles,
+                    // each minimum exact to rounding (see fuzz/src/serialized.rs).
+                    let a = g.query_volume(p, 1.3).unwrap().size;
+                    let b = fresh.query_volume(p, 1.3).unwrap().size;
+                    let tol = 1e-9 * a.max(b) + 1.3f64.ln() * 1e-6 * (g.bvh().coord_scale + 4.0);
+                    assert!((a - b).abs() <= tol, "{a} {b} at {p:?}");
                 }
             }
         }

@@ -9,8 +9,10 @@
 //! A call must return a status other than `ABGS_ERR_INTERNAL` (a panic aborts
 //! the fuzzer first). A grid that loads must satisfy [`crate::check_grid`],
 //! serialise back to exactly the bytes it came from, and answer the closest
-//! point and the volume size at a few points exactly as a grid built from the
-//! same arrays with a new BVH (so a forged BVH layout can change nothing).
+//! point at a few points exactly (bit for bit), and the volume size to
+//! rounding, as a grid built from the same arrays with a new BVH: a forged
+//! BVH layout can change nothing. (The volume query's per-triangle minimum
+//! is exact only to rounding, and two trees scan different triangles.)
 
 use abgs::ffi::*;
 use abgs::io::abgs_bin;
@@ -70,11 +72,21 @@ pub fn run(data: &[u8]) {
         // Debug text: the same bits, NaN (no sizes) equal to NaN.
         let (a, b) = (g.closest(p, None).ok(), fresh.closest(p, None).ok());
         assert_eq!(format!("{a:?}"), format!("{b:?}"), "at {p:?}");
-        if g.sizes().is_some() {
-            assert_eq!(
-                g.query_volume(p, 1.5).ok(),
-                fresh.query_volume(p, 1.5).ok(),
-                "volume at {p:?}"
+        if let (Some(_), Ok(a), Ok(b)) = (
+            g.sizes(),
+            g.query_volume(p, 1.5),
+            fresh.query_volume(p, 1.5),
+        ) {
+            // Both trees prune with the same exact bounds, but each triangle's
+            // minimum is computed with rounding (a point within rounding of a
+            // triangle counts as on it), so the trees, which scan different
+            // triangles, agree to rounding, not to the bit.
+            let s = 1.5f64.ln();
+            let scale = g.bvh().coord_scale + p.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            let tol = 1e-9 * a.size.max(b.size) + s * 1e-6 * scale;
+            assert!(
+                a.size.is_finite() && a.size > 0.0 && (a.size - b.size).abs() <= tol,
+                "volume at {p:?}: {a:?} with the stored layout, {b:?} with a built BVH"
             );
         }
     }

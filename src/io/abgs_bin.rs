@@ -127,10 +127,26 @@ fn decode_named(bytes: &[u8], name: &str) -> Result<Grid> {
     Grid::from_parts(parse(bytes, name)?)
 }
 
-/// Reads an `.abgs` file.
+/// Reads an `.abgs` file. A file that does not start with [`MAGIC`] is
+/// refused after its first bytes (a large file of another kind is not read).
 pub fn read(path: &Path) -> Result<Grid> {
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    decode_named(&bytes, &path.display().to_string())
+    use std::io::Read;
+    let name = path.display().to_string();
+    let io = |e| Error::io(path, e);
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut head = Vec::with_capacity(MIN_LEN);
+    (&mut file)
+        .take(MIN_LEN as u64)
+        .read_to_end(&mut head)
+        .map_err(io)?;
+    if !head.starts_with(&MAGIC) {
+        return Err(parse(&head, &name).err().unwrap_or_else(|| Error::Parse {
+            path: name.clone(),
+            msg: "not an abgs grid".into(),
+        }));
+    }
+    file.read_to_end(&mut head).map_err(io)?;
+    decode_named(&head, &name)
 }
 
 /// Writes `grid` to an `.abgs` file (BVH layout included).
