@@ -75,7 +75,7 @@ if [[ -z $(gmsh_lib) || ! -f $venv/include/gmshc.h ]]; then
 fi
 gmsh_so=$(gmsh_lib)
 [[ -n $gmsh_so ]] || fail "no libgmsh.so* under $venv/lib after installing the wheel"
-if ldd "$gmsh_so" | grep -q 'not found'; then
+if grep -q 'not found' <<<"$(ldd "$gmsh_so")"; then
   apt_install libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 \
     libfontconfig1 libx11-6 libgomp1
 fi
@@ -105,7 +105,8 @@ export PKG_CONFIG_PATH=$prefix/lib/pkgconfig
 abgs_flags=$(pkg-config --cflags --libs abgs)
 abgs_rpath=-Wl,-rpath,$(pkg-config --variable=libdir abgs)
 echo "pkg-config --cflags --libs abgs: $abgs_flags"
-pc=$work/pkgconfig
+pc=$work/build-pkgconfig
+rm -rf "$pc"
 mkdir -p "$pc"
 # shellcheck disable=SC2086 # flags are meant to be split
 {
@@ -115,8 +116,10 @@ mkdir -p "$pc"
   run cc -std=c11 -O2 $flags examples_c/gmsh_size_callback.c $abgs_flags $abgs_rpath \
     -I"$venv/include" "$gmsh_so" -Wl,-rpath,"$venv/lib" -lm -o "$pc/gmsh_size_callback"
 }
-for b in "$work"/build/{query_basic,pipeline,mpi_sizing,gmsh_size_callback} "$pc"/*; do
-  ldd "$b" | grep -q "$prefix/lib/libabgs.so" || fail "$b does not load $prefix/lib/libabgs.so"
+for b in {"$work/build","$pc"}/{query_basic,pipeline,mpi_sizing,gmsh_size_callback}; do
+  # (ldd into a variable: `ldd | grep -q` fails under pipefail when grep exits early.)
+  deps=$(ldd "$b")
+  grep -q "$prefix/lib/libabgs.so" <<<"$deps" || fail "$b does not load $prefix/lib/libabgs.so"
 done
 
 # --- 4. run ---------------------------------------------------------------------
@@ -126,7 +129,8 @@ mpi=(mpirun -np 2 --oversubscribe)
 export OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_btl_tcp_if_include=lo \
   OMPI_MCA_oob_tcp_if_include=lo
 run_all() { # run_all BUILD_DIR TAG
-  local bin=$1 tag=$2 out=$work/$2
+  local bin=$1 tag=$2 out=$work/out/$2
+  rm -rf "$out"
   mkdir -p "$out"
   step "$tag: pipeline $model.stl -> coarse.abgs"
   run "$bin/pipeline" "$meshes/$model.stl" "$out/coarse.abgs" 0.02 | tee "$out/pipeline.log"
@@ -144,7 +148,7 @@ run_all() { # run_all BUILD_DIR TAG
 }
 run_all "$work/build" cmake
 run_all "$pc" pkgconfig
-cmp "$work/cmake/coarse.abgs" "$work/pkgconfig/coarse.abgs" \
+cmp "$work/out/cmake/coarse.abgs" "$work/out/pkgconfig/coarse.abgs" \
   || fail "the two builds' pipelines wrote different grids"
 echo
 echo "run_examples: every example passed ($(($(date +%s) - start)) s)"
