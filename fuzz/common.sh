@@ -1,7 +1,7 @@
 # Shared by campaign.sh and smoke.sh (sourced, not run).
 
 # The targets, in campaign order.
-ALL_TARGETS=(stl_ascii stl_binary obj off ply msh22 msh41 vtk vtu medit arrays_query)
+ALL_TARGETS=(stl_ascii stl_binary obj off ply msh22 msh41 vtk vtu medit arrays_query deserialize)
 
 # Build configuration: release with debug assertions and overflow checks, no
 # sanitizer (abgs has no `unsafe` outside src/ffi), no comparison tracing (half

@@ -12,6 +12,7 @@ because they build a grid of several triangles and make several calls.
 import base64
 import os
 import struct
+import zlib
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus")
 
@@ -344,3 +345,44 @@ put("medit", "cube_quads_nosol", medit(cube_quads()[0], [], cube_quads()[1]))
 put("medit", "two_cubes_sol_fields", medit(*two_cubes()) + "\0" + sol(12, (2, 1)))
 put("medit", "square_dim2", medit([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)],
                                   [(0, 1, 2), (0, 2, 3)], dim=2) + "\0" + sol(4))
+
+
+# ---------------------------------------------------------------- .abgs (deserialize)
+# The binary grid of src/io/abgs_bin.rs, written here from the format's table;
+# the target's first byte steers (even: the harness fixes the length and the
+# checksum of the rest; odd: the rest goes in as it is). BVH layouts: none, one
+# leaf holding every triangle, or a root with two leaves (any such tree is a
+# valid layout: the boxes are recomputed on load).
+def abgs(v, t, with_sizes=True, arrays=(), bvh=None):
+    nv, nt = len(v), len(t)
+    body = b""
+    body += struct.pack("<%dd" % (3 * nv), *[c for p in v for c in p])
+    body += struct.pack("<%dI" % (3 * nt), *[i for f in t for i in f])
+    if with_sizes:
+        body += struct.pack("<%dd" % nv, *sizes(nv))
+    for name, vals in arrays:
+        body += struct.pack("<I", len(name)) + name.encode() + struct.pack("<%dd" % nv, *vals)
+    nodes = []
+    if bvh == "leaf":
+        nodes = [(0, nt)]
+    elif bvh == "split":
+        k = nt // 2
+        nodes = [(2, 0), (0, k), (k, nt - k)]
+    if nodes:
+        body += b"".join(struct.pack("<II", *n) for n in nodes)
+        body += struct.pack("<%dI" % nt, *range(nt))
+    flags = (1 if with_sizes else 0) | (2 if nodes else 0)
+    history = struct.pack("<8Q", nv, nt, 0, 0, 0, 0, 0, 0)
+    total = 64 + len(history) + len(body) + 4
+    header = b"\x89ABGS\r\n\x1a" + struct.pack("<IIII", 1, 0x0A0B0C0D, flags, len(arrays))
+    header += struct.pack("<QQQQQ", nv, nt, len(nodes), total, 0)
+    data = header + history + body
+    return data + struct.pack("<I", zlib.crc32(data) & 0xFFFFFFFF)
+
+
+put("deserialize", "tetra", b"\x00" + abgs(*tetra()))
+put("deserialize", "tetra_asis", b"\x01" + abgs(*tetra(), bvh="leaf"))
+put("deserialize", "cube_leaf_array", b"\x00" + abgs(*cube(), bvh="leaf",
+                                                    arrays=[("h0", [0.5] * 8)]))
+put("deserialize", "two_cubes_split", b"\x00" + abgs(*two_cubes(), bvh="split"))
+put("deserialize", "cube_no_sizes", b"\x02" + abgs(*cube(), with_sizes=False, bvh="split"))

@@ -612,11 +612,13 @@ abgs_status abgs_grid_from_arrays(const double *xyz,
                                   abgs_grid **out_grid);
 
 // Loads a grid from a file, format by extension (stl, obj, off, ply, msh, vtk,
-// vtu, mesh). STL is welded (tolerance 1e-7 of the diagonal); a per-vertex
-// array named `size` becomes the sizes.
+// vtu, mesh, abgs). STL is welded (tolerance 1e-7 of the diagonal); a per-vertex
+// array named `size` becomes the sizes. An `.abgs` file (`abgs_grid_save`'s
+// binary form, the bytes of `abgs_grid_serialize`) gives the saved grid back
+// bit for bit, BVH included, checked as `abgs_grid_deserialize` checks it.
 //
 // Errors: NULL, IO, PARSE, UNSUPPORTED_FORMAT, NON_FINITE, OUT_OF_RANGE,
-// INVALID_SIZE, EMPTY.
+// INVALID_SIZE, EMPTY (and INVALID_ARGUMENT for an inconsistent `.abgs`).
 //
 // # Safety
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
@@ -625,7 +627,8 @@ abgs_status abgs_grid_load(const char *path, abgs_grid **out_grid);
 
 // Writes the grid (with sizes as point data `size`) to a file, format by
 // extension: vtk (ParaView), msh (Gmsh background field), mesh (+ .sol for
-// MMG), vtu, ply, obj, off, stl.
+// MMG), vtu, ply, obj, off, stl, or abgs (the whole grid in binary, fastest
+// to load: the bytes of `abgs_grid_serialize`).
 //
 // # Safety
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
@@ -919,6 +922,51 @@ abgs_status abgs_grid_remesh_issue(const abgs_grid *grid,
                                    char *out_text,
                                    size_t capacity,
                                    size_t *out_len);
+
+// Serialises `grid` into the caller's buffer `buf` of `capacity` bytes:
+// vertices, triangles, sizes, other per-vertex arrays, the input report and
+// the BVH layout, with a format version, a byte-order marker and a CRC-32
+// (the `.abgs` format; `abgs_grid_save` writes the same bytes to a `.abgs`
+// file). `*out_len` receives the bytes needed — also when the buffer is too
+// small, and alone when `buf` is NULL with `capacity` 0, so a caller asks
+// first, allocates, then calls again:
+//
+// ```c
+// size_t n = 0;
+// abgs_grid_serialize(g, NULL, 0, &n);
+// void *buf = malloc(n);
+// abgs_grid_serialize(g, buf, n, &n);
+// ```
+//
+// Errors: NULL (grid, out_len, or buf with capacity > 0), BUFFER_TOO_SMALL
+// (nothing written to `buf`), BUSY (a mutation is running on the grid).
+// O(V + F); the bytes depend only on the grid.
+//
+// # Safety
+// `grid` is NULL or a live grid from this library; `buf` is NULL or holds
+// `capacity` writable bytes; `out_len` is NULL or writable.
+abgs_status abgs_grid_serialize(const abgs_grid *grid, void *buf, size_t capacity, size_t *out_len);
+
+// Builds a grid from `len` bytes at `buf` written by `abgs_grid_serialize`
+// (or read from a `.abgs` file); the bytes are only read (the caller keeps
+// them, and may free them once the call returns). Everything is checked before use: the length, magic, format
+// version, byte order and CRC-32 first, then the counts against the length
+// (before anything is allocated), then the content as
+// `abgs_grid_from_arrays` checks it (coordinates, indices, sizes) and the
+// stored BVH layout. The grid answers every query bit for bit as the one
+// serialised. On success `*out_grid` owns a new grid; on failure it is NULL.
+// O(V + F log F) (the adjacency is rebuilt).
+//
+// Errors: NULL (buf, out_grid), PARSE (truncated, corrupt, checksum
+// mismatch, counts that disagree with the length, not an abgs buffer), UNSUPPORTED_FORMAT (another format version, big-endian),
+// NON_FINITE, OUT_OF_RANGE, INVALID_SIZE, EMPTY, INVALID_ARGUMENT (a
+// degenerate triangle, an inconsistent report or BVH layout).
+//
+// # Safety
+// `buf` is NULL or holds `len` readable bytes; `out_grid` is NULL or writable.
+abgs_status abgs_grid_deserialize(const void *buf,
+                                  size_t len,
+                                  abgs_grid **out_grid);
 
 // Writes the default parameters into `*out_params`, whose `struct_size` the
 // caller has set (`abgs_simplify_params p = {.struct_size = sizeof p};`).

@@ -189,6 +189,54 @@ fn obj(vertex0: &str, extra_face: &str) -> Vec<u8> {
     s.into_bytes()
 }
 
+/// The sized cube serialised through the ABI (`.abgs` bytes).
+fn cube_abgs() -> Vec<u8> {
+    let mut b = Vec::new();
+    with_cube(true, |g| {
+        let mut n = 0usize;
+        // SAFETY: a valid grid; size query (NULL, 0), then a buffer of n bytes.
+        unsafe {
+            assert_eq!(abgs_grid_serialize(g, null_mut(), 0, &mut n), ABGS_OK);
+            b = vec![0u8; n];
+            assert_eq!(
+                abgs_grid_serialize(g, b.as_mut_ptr().cast(), n, &mut n),
+                ABGS_OK
+            );
+        }
+        outcome(ABGS_OK)
+    });
+    b
+}
+
+/// `cube_abgs()` edited by `f`, its checksum made right again when `reseal`.
+fn cube_abgs_with(f: impl FnOnce(&mut Vec<u8>), reseal: bool) -> Vec<u8> {
+    let mut b = cube_abgs();
+    f(&mut b);
+    if reseal {
+        let n = b.len() - 4;
+        let crc = crc32fast::hash(&b[..n]);
+        b[n..].copy_from_slice(&crc.to_le_bytes());
+    }
+    b
+}
+
+/// Deserialises `bytes` through the ABI, checking that they are unchanged
+/// and that a failure leaves `*out` NULL.
+fn deserialize(bytes: &[u8]) -> Outcome {
+    let copy = bytes.to_vec();
+    let mut g = std::ptr::dangling_mut::<abgs_grid>();
+    // SAFETY: `bytes` is readable for its length; `g` is writable.
+    let st = unsafe { abgs_grid_deserialize(bytes.as_ptr().cast(), bytes.len(), &mut g) };
+    let o = outcome(st);
+    assert_eq!(bytes, copy, "the buffer was modified");
+    if st == ABGS_OK {
+        free(g);
+    } else {
+        assert!(g.is_null(), "out_grid not NULL after a failure");
+    }
+    o
+}
+
 /// Simplify parameters from the defaults, edited by `f`, run on a sized cube;
 /// the parameter struct must come back unchanged.
 /// A parameter struct of type `T` from the library's defaults
@@ -996,6 +1044,89 @@ fn cases() -> Vec<(
                 o
             })),
         ),
+        // ---- .abgs binary grids (abgs_grid_deserialize, abgs_grid_load) ----
+        (
+            "abgs file with one byte changed",
+            ABGS_ERR_PARSE,
+            "checksum",
+            c(Box::new(|| {
+                load_bytes("abgs", &cube_abgs_with(|b| b[200] ^= 1, false))
+            })),
+        ),
+        (
+            "abgs file truncated",
+            ABGS_ERR_PARSE,
+            "truncated",
+            c(Box::new(|| {
+                let b = cube_abgs();
+                load_bytes("abgs", &b[..b.len() - 9])
+            })),
+        ),
+        (
+            "abgs buffer of format version 2",
+            ABGS_ERR_UNSUPPORTED_FORMAT,
+            "version 2",
+            c(Box::new(|| {
+                deserialize(&cube_abgs_with(|b| b[8] = 2, true))
+            })),
+        ),
+        (
+            "abgs buffer written big-endian",
+            ABGS_ERR_UNSUPPORTED_FORMAT,
+            "big-endian",
+            c(Box::new(|| {
+                deserialize(&cube_abgs_with(
+                    |b| b[12..16].copy_from_slice(&[10, 11, 12, 13]),
+                    true,
+                ))
+            })),
+        ),
+        (
+            "abgs buffer claiming 2^32-1 vertices (memory bomb)",
+            ABGS_ERR_PARSE,
+            "do not fit",
+            c(Box::new(|| {
+                deserialize(&cube_abgs_with(
+                    |b| b[24..32].copy_from_slice(&(u32::MAX as u64).to_le_bytes()),
+                    true,
+                ))
+            })),
+        ),
+        (
+            "abgs buffer with a NaN coordinate behind a valid checksum",
+            ABGS_ERR_NON_FINITE,
+            "vertex 1",
+            c(Box::new(|| {
+                deserialize(&cube_abgs_with(
+                    |b| b[128 + 24..128 + 32].copy_from_slice(&f64::NAN.to_le_bytes()),
+                    true,
+                ))
+            })),
+        ),
+        (
+            "abgs buffer that is an STL",
+            ABGS_ERR_PARSE,
+            "not an abgs grid",
+            c(Box::new(|| deserialize(&binary_stl(2, 2)))),
+        ),
+        (
+            "abgs serialise into a buffer one byte short",
+            ABGS_ERR_BUFFER_TOO_SMALL,
+            "needed",
+            c(Box::new(|| {
+                with_cube(true, |g| {
+                    let n = cube_abgs().len();
+                    let mut b = vec![7u8; n - 1];
+                    let mut len = 0usize;
+                    // SAFETY: a valid grid, a buffer of n - 1 bytes.
+                    let st =
+                        unsafe { abgs_grid_serialize(g, b.as_mut_ptr().cast(), n - 1, &mut len) };
+                    assert_eq!(len, n, "the size needed is reported");
+                    assert!(b.iter().all(|&x| x == 7), "nothing written");
+                    outcome(st)
+                })
+            })),
+        ),
     ]
 }
 
@@ -1047,6 +1178,26 @@ fn every_null() -> Outcome {
             ("load out", abgs_grid_load(path.as_ptr(), null_mut())),
             ("save grid", abgs_grid_save(null(), path.as_ptr())),
             ("save path", abgs_grid_save(g, null())),
+            (
+                "serialize grid",
+                abgs_grid_serialize(null(), null_mut(), 0, &mut n),
+            ),
+            (
+                "serialize len",
+                abgs_grid_serialize(g, null_mut(), 0, null_mut()),
+            ),
+            (
+                "serialize buf",
+                abgs_grid_serialize(g, null_mut(), 10, &mut n),
+            ),
+            (
+                "deserialize buf",
+                abgs_grid_deserialize(null(), 10, &mut out),
+            ),
+            (
+                "deserialize out",
+                abgs_grid_deserialize(p.as_ptr().cast(), 24, null_mut()),
+            ),
             ("set_sizes sizes", abgs_grid_set_sizes(g, null(), 8)),
             ("stats out", abgs_grid_get_stats(g, null_mut())),
             ("vertex count out", abgs_grid_vertex_count(g, null_mut())),

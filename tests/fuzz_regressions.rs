@@ -146,3 +146,43 @@ fn ply_binary_element_without_properties_is_skipped_at_once() {
     let e = r.unwrap_err();
     assert!(matches!(e, Error::Parse { .. }), "{e}");
 }
+
+/// deserialize (`fuzz/regressions/deserialize/huge_size_beside_small`, the fuzz
+/// input: a steering byte, then a `.abgs` buffer whose length and checksum the
+/// harness fixes): two cubes with one vertex size 1e197 beside sizes near 0.5.
+/// The volume query's edge minimum computed `hp + t(hq − hp)`, which is 0 at
+/// t = 1 when hp dwarfs hq, so a triangle scanned in one BVH (a forged but
+/// valid layout: one leaf per cube) answered below every size it holds,
+/// while the same grid with a built BVH pruned it. Now `(1 − t)hp + t·hq`:
+/// both agree with the minimum over every triangle.
+#[test]
+fn deserialize_huge_size_beside_small_volume_is_exact() {
+    use abgs::io::abgs_bin;
+    use abgs::query::volume::triangle_min;
+    let input = std::fs::read(regression("deserialize", "huge_size_beside_small")).unwrap();
+    let mut b = input[1..].to_vec(); // the steering byte (even: fix length and checksum)
+    let n = b.len();
+    b[48..56].copy_from_slice(&(n as u64).to_le_bytes());
+    let crc = crc32fast::hash(&b[..n - 4]);
+    b[n - 4..].copy_from_slice(&crc.to_le_bytes());
+    let g = abgs_bin::decode(&b).unwrap();
+    let fresh = Grid::from_parts(g.to_parts(false)).unwrap();
+    let h = g.sizes().unwrap();
+    assert!(h.iter().any(|&x| x > 1e190), "the huge size is there");
+    let (x, s) = ([0.808, 0.724, 0.532], 1.5f64.ln());
+    let brute = g
+        .triangles()
+        .iter()
+        .map(|t| {
+            let c = t.map(|v| g.vertices()[v as usize]);
+            triangle_min(x, c, t.map(|v| h[v as usize]), s).0
+        })
+        .fold(f64::INFINITY, f64::min);
+    let (a, b) = (
+        g.query_volume(x, 1.5).unwrap(),
+        fresh.query_volume(x, 1.5).unwrap(),
+    );
+    assert_eq!(a.size, brute);
+    assert_eq!(a, b);
+    assert!(a.size >= 0.1, "{a:?}");
+}

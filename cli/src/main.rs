@@ -47,13 +47,14 @@ pub enum Mode {
 enum Command {
     /// Load a surface and report counts, defects, bounding box, angles and memory.
     Info {
-        /// Input file (stl, obj, off, ply, msh, vtk, vtu, mesh).
+        /// Input file (stl, obj, off, ply, msh, vtk, vtu, mesh, abgs).
         file: PathBuf,
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
     },
-    /// Convert between formats (chosen by extension); per-vertex arrays are kept where the format allows.
+    /// Convert between formats (chosen by extension); per-vertex arrays are kept where the format allows;
+    /// `.abgs` keeps the whole grid in binary (fastest to load).
     Convert {
         /// Input file.
         input: PathBuf,
@@ -177,7 +178,7 @@ enum Command {
     /// DIR/dense.vtk, DIR/simplified.vtk, DIR/report.json, DIR/preview.png and
     /// DIR/convergence.png.
     Run {
-        /// Input surface (stl, obj, off, ply, msh, vtk, vtu, mesh).
+        /// Input surface (stl, obj, off, ply, msh, vtk, vtu, mesh, abgs).
         input: PathBuf,
         #[command(flatten)]
         args: run::RunArgs,

@@ -138,7 +138,7 @@ fn query_answers_in_order_in_both_modes() {
 #[test]
 fn convert_round_trips_sizes() {
     let grid = sized_grid("convert");
-    for ext in ["msh", "vtu", "ply", "mesh"] {
+    for ext in ["msh", "vtu", "ply", "mesh", "abgs"] {
         let out_path = tmp(&format!("conv.{ext}"));
         let st = abgs()
             .arg("convert")

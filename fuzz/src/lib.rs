@@ -23,6 +23,7 @@
 //! ([`alloc_limit`]) therefore aborts on any single request over 2 GiB.
 
 pub mod arrays;
+pub mod serialized;
 
 mod alloc_limit;
 

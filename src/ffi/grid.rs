@@ -122,11 +122,13 @@ pub unsafe extern "C" fn abgs_grid_from_arrays(
 }
 
 /// Loads a grid from a file, format by extension (stl, obj, off, ply, msh, vtk,
-/// vtu, mesh). STL is welded (tolerance 1e-7 of the diagonal); a per-vertex
-/// array named `size` becomes the sizes.
+/// vtu, mesh, abgs). STL is welded (tolerance 1e-7 of the diagonal); a per-vertex
+/// array named `size` becomes the sizes. An `.abgs` file (`abgs_grid_save`'s
+/// binary form, the bytes of `abgs_grid_serialize`) gives the saved grid back
+/// bit for bit, BVH included, checked as `abgs_grid_deserialize` checks it.
 ///
 /// Errors: NULL, IO, PARSE, UNSUPPORTED_FORMAT, NON_FINITE, OUT_OF_RANGE,
-/// INVALID_SIZE, EMPTY.
+/// INVALID_SIZE, EMPTY (and INVALID_ARGUMENT for an inconsistent `.abgs`).
 ///
 /// # Safety
 /// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated
@@ -149,7 +151,8 @@ pub unsafe extern "C" fn abgs_grid_load(
 
 /// Writes the grid (with sizes as point data `size`) to a file, format by
 /// extension: vtk (ParaView), msh (Gmsh background field), mesh (+ .sol for
-/// MMG), vtu, ply, obj, off, stl.
+/// MMG), vtu, ply, obj, off, stl, or abgs (the whole grid in binary, fastest
+/// to load: the bytes of `abgs_grid_serialize`).
 ///
 /// # Safety
 /// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated

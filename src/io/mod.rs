@@ -16,10 +16,12 @@
 //! | VTK legacy `.vtk` | yes | yes | POINT_DATA arrays |
 //! | VTK XML `.vtu` | yes | yes | PointData arrays |
 //! | Medit `.mesh` + `.sol` | yes | yes | the `.sol` scalar |
+//! | abgs binary `.abgs` ([`abgs_bin`]) | yes | yes | sizes, arrays, BVH layout |
 
 use crate::error::{Error, Result};
 use std::path::Path;
 
+pub mod abgs_bin;
 mod medit;
 mod msh;
 mod obj;
@@ -77,6 +79,8 @@ pub enum Format {
     Vtu,
     /// Medit `.mesh` with an optional `.sol` beside it.
     Medit,
+    /// abgs's own binary form of a whole grid (`.abgs`, [`abgs_bin`]).
+    Abgs,
 }
 
 impl Format {
@@ -96,9 +100,10 @@ impl Format {
             "vtk" => Format::Vtk,
             "vtu" => Format::Vtu,
             "mesh" => Format::Medit,
+            "abgs" => Format::Abgs,
             _ => {
                 return Err(Error::UnsupportedFormat(format!(
-                "'{}': unknown extension '{}' (expected stl, obj, off, ply, msh, vtk, vtu or mesh)",
+                "'{}': unknown extension '{}' (expected stl, obj, off, ply, msh, vtk, vtu, mesh or abgs)",
                 path.display(),
                 ext
             )))
@@ -118,6 +123,7 @@ pub fn read(path: &Path) -> Result<SurfaceData> {
         Format::Vtk => vtk::read_legacy(path)?,
         Format::Vtu => vtk::read_vtu(path)?,
         Format::Medit => medit::read(path)?,
+        Format::Abgs => abgs_bin::read(path)?.to_surface(),
     };
     for a in &data.point_data {
         if a.values.len() != data.vertices.len() {
@@ -158,5 +164,16 @@ pub fn write(path: &Path, data: &SurfaceData) -> Result<()> {
         Format::Vtk => vtk::write_legacy(path, data),
         Format::Vtu => vtk::write_vtu(path, data),
         Format::Medit => medit::write(path, data),
+        Format::Abgs => {
+            // A grid of the data as it is (no welding, no re-orienting).
+            let options = crate::mesh::BuildOptions {
+                weld_relative_tolerance: None,
+                orient: false,
+            };
+            abgs_bin::write(
+                path,
+                &crate::mesh::Grid::from_surface(data.clone(), &options)?,
+            )
+        }
     }
 }

@@ -4,6 +4,7 @@
 pub mod feature_lines;
 pub mod features;
 pub mod halfedge;
+mod restore;
 pub mod shape;
 pub(crate) mod stats;
 mod topology;
@@ -11,6 +12,7 @@ mod validate;
 pub mod weld;
 
 pub use features::Features;
+pub use restore::{GridParts, InputHistory};
 pub use stats::{AngleStats, GridStats};
 pub use topology::Topology;
 pub use validate::ValidationReport;
@@ -74,6 +76,14 @@ pub struct Grid {
     bvh: Bvh,
     bbox: Aabb,
     report: ValidationReport,
+}
+
+/// The arrays of a grid once checked, before its adjacency and hierarchy.
+struct Checked {
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    sizes: Option<Vec<f64>>,
+    extra: Vec<PointArray>,
 }
 
 /// Smallest and largest bounding-box diagonal a grid may have. The pipeline
@@ -140,24 +150,7 @@ impl Grid {
             mut triangles,
             mut point_data,
         } = data;
-        if vertices.is_empty() || triangles.is_empty() {
-            return Err(Error::Empty(format!(
-                "{} vertices and {} triangles given",
-                vertices.len(),
-                triangles.len()
-            )));
-        }
-        validate::check_input(&vertices, &triangles)?;
-        for a in &point_data {
-            if a.values.len() != vertices.len() {
-                return Err(Error::InvalidArgument(format!(
-                    "array '{}' has {} values for {} vertices",
-                    a.name,
-                    a.values.len(),
-                    vertices.len()
-                )));
-            }
-        }
+        check_arrays(&vertices, &triangles, &point_data)?;
         let sizes = match point_data.iter().position(|a| a.name == "size") {
             Some(i) => {
                 let s = point_data.remove(i).values;
@@ -219,6 +212,37 @@ impl Grid {
             }
         }
         let triangles = kept;
+        let bvh = Bvh::build(&vertices, &triangles);
+        Ok(Grid::assemble(
+            Checked {
+                vertices,
+                triangles,
+                sizes,
+                extra: point_data,
+            },
+            topology,
+            bvh,
+            report,
+        ))
+    }
+
+    /// The grid over checked parts (indices in range, no degenerate
+    /// triangle, sizes valid) with their adjacency and hierarchy: fills the
+    /// report's counts that follow from the triangles (the input history —
+    /// input counts, welded, dropped, flipped — is the caller's).
+    /// O(F log F).
+    fn assemble(
+        parts: Checked,
+        topology: Topology,
+        bvh: Bvh,
+        mut report: ValidationReport,
+    ) -> Grid {
+        let Checked {
+            vertices,
+            triangles,
+            sizes,
+            extra,
+        } = parts;
         report.duplicate_triangles = validate::count_duplicates(&triangles);
         report.boundary_edges = topology.boundary_edge_count();
         report.non_manifold_edges = topology.non_manifold_edge_count();
@@ -237,14 +261,13 @@ impl Grid {
         }
         report.open_bodies = open.iter().filter(|&&o| o).count();
         report.sliver_triangles = stats::count_slivers(&vertices, &triangles, 1.0);
-        let bvh = Bvh::build(&vertices, &triangles);
         let mut grid = Grid {
             bbox: Aabb::from_points(&vertices),
             vertices,
             triangles,
             sizes: None,
             node_min_size: Vec::new(),
-            extra: point_data,
+            extra,
             topology,
             bvh,
             report,
@@ -252,20 +275,29 @@ impl Grid {
         if let Some(s) = sizes {
             grid.install_sizes(s);
         }
-        Ok(grid)
+        grid
     }
 
     /// Reads a grid from a file (format by extension). STL is welded with
     /// [`BuildOptions::SOUP_WELD_TOLERANCE`]; a `size` point array becomes the sizes.
+    /// An `.abgs` file ([`crate::io::abgs_bin`]) gives back the grid that was
+    /// saved, hierarchy and input report included.
     pub fn load(path: &Path) -> Result<Grid> {
         let format = Format::from_path(path)?;
+        if format == Format::Abgs {
+            return crate::io::abgs_bin::read(path);
+        }
         let data = crate::io::read(path)?;
         Grid::from_surface(data, &BuildOptions::for_format(format))
     }
 
     /// Writes the grid (sizes as point array `size`, plus any other arrays read
-    /// with it) to `path`, format by extension.
+    /// with it) to `path`, format by extension; `.abgs` stores the whole grid
+    /// ([`crate::io::abgs_bin`]).
     pub fn save(&self, path: &Path) -> Result<()> {
+        if Format::from_path(path)? == Format::Abgs {
+            return crate::io::abgs_bin::write(path, self);
+        }
         crate::io::write(path, &self.to_surface())
     }
 
@@ -377,6 +409,33 @@ impl Grid {
     pub fn report(&self) -> &ValidationReport {
         &self.report
     }
+}
+
+/// Checks a grid's raw arrays: at least one vertex and one triangle, finite
+/// coordinates, indices in range, one value per vertex in each point array.
+/// O(V + F).
+fn check_arrays(
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    point_data: &[PointArray],
+) -> Result<()> {
+    if vertices.is_empty() || triangles.is_empty() {
+        return Err(Error::Empty(format!(
+            "{} vertices and {} triangles given",
+            vertices.len(),
+            triangles.len()
+        )));
+    }
+    validate::check_input(vertices, triangles)?;
+    if let Some(a) = point_data.iter().find(|a| a.values.len() != vertices.len()) {
+        return Err(Error::InvalidArgument(format!(
+            "array '{}' has {} values for {} vertices",
+            a.name,
+            a.values.len(),
+            vertices.len()
+        )));
+    }
+    Ok(())
 }
 
 /// Checks that `sizes` has `n` values, each finite and > 0.

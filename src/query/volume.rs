@@ -45,7 +45,10 @@ pub fn slope_from_beta(beta: f64) -> Result<f64> {
 fn edge_min(x: [f64; 3], p: [f64; 3], q: [f64; 3], hp: f64, hq: f64, s: f64) -> (f64, f64) {
     let d = sub(q, p);
     let l2 = norm2(d);
-    let f = |t: f64| hp + t * (hq - hp) + s * norm(sub(x, lerp(p, q, t)));
+    // (1 − t)·hp + t·hq, not hp + t(hq − hp): exact at both ends, where the
+    // latter gives 0 at t = 1 when hp dwarfs hq (hp = 1e197, hq = 0.45: found
+    // by fuzzing), a value below every size of the edge.
+    let f = |t: f64| (1.0 - t) * hp + t * hq + s * norm(sub(x, lerp(p, q, t)));
     let (f0, f1) = (f(0.0), f(1.0));
     let (mut best, mut bt) = if f1 < f0 { (f1, 1.0) } else { (f0, 0.0) };
     if l2 > 0.0 {
@@ -245,6 +248,21 @@ mod tests {
             }
         }
         best
+    }
+
+    /// Sizes of very different magnitude on one edge: the value at an end is
+    /// that end's size, never lost to cancellation (the minimum here is at the
+    /// vertex of size 0.45, at distance 1 from x).
+    #[test]
+    fn triangle_min_keeps_small_sizes_beside_huge_ones() {
+        let c = [[2.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
+        let x = [1.0, 0.0, 2.0];
+        for big in [1e20, 1e197, 1e300] {
+            let (v, b) = triangle_min(x, c, [big, 0.45, 0.5], 0.4);
+            assert_eq!(v, 0.45 + 0.4, "{big}: {v} at {b:?}");
+            let (v, _) = triangle_min(x, [c[1], c[0], c[2]], [0.45, big, 0.5], 0.4);
+            assert_eq!(v, 0.45 + 0.4, "{big}: {v}");
+        }
     }
 
     #[test]

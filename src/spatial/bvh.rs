@@ -144,12 +144,7 @@ impl Bvh {
             return Bvh::default();
         }
         let nodes = build_rec(&mut prims, 0, 0);
-        let b = nodes[0].bbox;
-        let coord_scale = b
-            .min
-            .iter()
-            .chain(&b.max)
-            .fold(0.0f64, |m, c| m.max(c.abs()));
+        let coord_scale = coord_scale(&nodes[0].bbox);
         let prim_triangle: Vec<u32> = prims.iter().map(|p| p.tri).collect();
         let prim_corners = prim_triangle
             .iter()
@@ -402,6 +397,14 @@ impl Bvh {
         }
         out
     }
+}
+
+/// Largest absolute coordinate of the root box `b` ([`Bvh::coord_scale`]).
+pub(super) fn coord_scale(b: &Aabb) -> f64 {
+    b.min
+        .iter()
+        .chain(&b.max)
+        .fold(0.0f64, |m, c| m.max(c.abs()))
 }
 
 /// Builds the subtree over `prims` (which start at slot `offset` of the final

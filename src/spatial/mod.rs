@@ -1,7 +1,9 @@
 //! Spatial indexing: a bounding-volume hierarchy over triangles.
 
 mod bvh;
+mod layout;
 mod ray;
 
 pub use bvh::{Bvh, ClosestHit, Node, MAX_DEPTH};
+pub use layout::BvhLayout;
 pub use ray::ray_triangle;
