@@ -1,6 +1,6 @@
 // netgen_mesh STEP --dense DENSE --simplified SIMPLIFIED --stl STL [--work DIR]
 //             [--grading G] [--spacing S] [--cases a,b,c]
-//             [--check [--triangle-tolerance T] [--p50 LOW,HIGH]]
+//             [--check [--triangle-tolerance T] [--p50 LOW,HIGH] [--p50-step D]]
 //
 // Netgen 6.2 (Debian's nglib, OpenCASCADE geometry) meshes the surfaces
 // (dimension 2) of a STEP model with an abgs grid as its size field:
@@ -58,9 +58,17 @@
 // / h_dense(midpoint), mean and 5th, 50th, 95th percentiles. Netgen's own
 // messages go to stderr; one JSON object goes to stdout.
 // --check (with cases a and b): the simplified grid must give Netgen what the
-// dense one gives: triangles of (b) within ±T of (a) (default T = 0.05), no
-// more open edges than (a), and edge / h_dense p50 of (a) and (b) within
-// [LOW, HIGH] (default 0.7,1.4); see bench/paper_tables.sh.
+// dense one gives: triangles of (b) within ±T of (a) (default 0.12), (b)
+// closed where (a) is, and edge / h_dense p50 of (a) and (b) within
+// [LOW, HIGH] (default 0.8,1.25) and at most D apart (default 0.1). Why
+// these: Netgen's octree keeps about the minimum of the sizes given in each
+// cell, so it realises a rougher field finer; the dense grid's field varies
+// more from vertex to vertex than the simplified grid's, and Netgen meshes it
+// up to 9 % finer (−0.5 % to −8.9 % triangles with (b) over the 8 STEP
+// models, p50 up by at most 0.055; Gmsh, which samples the field pointwise,
+// sees −3 % to +2 %). A simplified field off by the simplifier's own bound
+// (1.2×) would move the triangles by −31 % or +44 %, and a broken hand-over
+// (units, skipped restrictions) moves p50 far out of [0.8, 1.25].
 // Exit status: 0 every case meshed (and the check passed), 1 a case produced
 // no triangles, Netgen reported an error or the check failed, 2 error.
 #include "gmsh_step.hpp"
@@ -182,9 +190,9 @@ std::vector<double> triangles(nglib::Ng_Mesh *mesh, double scale, size_t *open_e
 int main(int argc, char **argv) {
     Args args(argc, argv);
     if (args.pos.size() != 1 || !args.has("dense") || !args.has("simplified") || !args.has("stl")) {
-        std::fprintf(stderr, "usage: netgen_mesh STEP --dense DENSE --simplified SIMPLIFIED --stl STL "
+        std::fprintf(stderr, "usage: netgen_mesh STEP --dense DENSE --simplified SIMPLIFIED --stl STL [--work DIR] "
                              "[--grading G] [--spacing S] [--cases a,b,c] "
-                             "[--check [--triangle-tolerance T] [--p50 LOW,HIGH]]\n");
+                             "[--check [--triangle-tolerance T] [--p50 LOW,HIGH] [--p50-step D]]\n");
         return 2;
     }
     const std::string step = args.pos[0], cases_arg = args.str("cases", "a,b,c");
@@ -194,15 +202,15 @@ int main(int argc, char **argv) {
         return 2;
     }
     const bool check_on = args.has("check");
-    const double tri_tol = args.num("triangle-tolerance", 0.05);
-    double p50_lo = 0.7, p50_hi = 1.4;
+    const double tri_tol = args.num("triangle-tolerance", 0.12), p50_step = args.num("p50-step", 0.1);
+    double p50_lo = 0.8, p50_hi = 1.25;
     if (args.has("p50") && std::sscanf(args.str("p50", "").c_str(), "%lf,%lf", &p50_lo, &p50_hi) != 2) {
         std::fprintf(stderr, "--p50 takes LOW,HIGH\n");
         return 2;
     }
     if (check_on && (cases_arg.find('a') == std::string::npos || cases_arg.find('b') == std::string::npos ||
-                     !(tri_tol > 0) || !(p50_lo < p50_hi))) {
-        std::fprintf(stderr, "--check needs cases a and b, a positive tolerance and LOW < HIGH\n");
+                     !(tri_tol > 0) || !(p50_step > 0) || !(p50_lo < p50_hi))) {
+        std::fprintf(stderr, "--check needs cases a and b, positive tolerances and LOW < HIGH\n");
         return 2;
     }
     // Netgen writes its progress to std::cout: send it to stderr (stdout is
@@ -325,6 +333,8 @@ int main(int argc, char **argv) {
         // ~Mesh in this Netgen version (free of an invalid pointer); the
         // process ends after the three cases.
         const EdgeRatio q = EdgeRatio::of(dense, tris);
+        // Against the field Netgen was given (the same as q for the dense grid).
+        const EdgeRatio own = c.grid == &dense ? q : EdgeRatio::of(*c.grid, tris);
         const std::string k = c.name;
         out.num(k + "_triangles", static_cast<double>(nt))
             .num(k + "_nodes", static_cast<double>(nodes))
@@ -340,32 +350,38 @@ int main(int argc, char **argv) {
             .num(k + "_ratio_p5", q.p5)
             .num(k + "_ratio_p50", q.p50)
             .num(k + "_ratio_p95", q.p95)
+            .num(k + "_own_ratio_p5", own.p5)
+            .num(k + "_own_ratio_p50", own.p50)
+            .num(k + "_own_ratio_p95", own.p95)
             .boolean(k + "_ok", surface);
         std::fprintf(stderr,
                      "(%s) %-10s %8zu triangles %8zu nodes %6zu open edges  %zu points  local h %.3f s"
                      "  restrict %.3f s  meshing %.3f s (edges %.3f, CPU %.3f)  edge/h_dense mean %.3f p5 %.3f "
-                     "p50 %.3f p95 %.3f%s\n",
+                     "p50 %.3f p95 %.3f (own grid: p5 %.3f p50 %.3f p95 %.3f)%s\n",
                      c.tag, c.name, nt, nodes, open, r.h.size(), local_h_s, restrict_s, seconds, edge_s, cpu, q.mean,
-                     q.p5, q.p50, q.p95, surface ? "" : "  (Netgen reported an error)");
+                     q.p5, q.p50, q.p95, own.p5, own.p50, own.p95, surface ? "" : "  (Netgen reported an error)");
         if (nt == 0 || !surface) ok = false;
         result[&c - cases] = {static_cast<double>(nt), static_cast<double>(open), q.p50};
     }
     if (check_on) {
         const Outcome &a = result[0], &b = result[1];
-        const bool tri_ok = a.triangles > 0 && std::fabs(b.triangles / a.triangles - 1) <= tri_tol && b.open <= a.open;
+        const bool tri_ok = a.triangles > 0 && std::fabs(b.triangles / a.triangles - 1) <= tri_tol;
+        const bool closed_ok = a.open > 0 || b.open == 0;
         auto in = [&](double x) { return x >= p50_lo && x <= p50_hi; };
-        const bool p50_ok = in(a.p50) && in(b.p50);
+        const bool p50_ok = in(a.p50) && in(b.p50) && std::fabs(b.p50 - a.p50) <= p50_step;
         out.num("check_triangle_tolerance", tri_tol)
             .num("check_p50_low", p50_lo)
             .num("check_p50_high", p50_hi)
-            .boolean("check_triangles", tri_ok)
+            .num("check_p50_step", p50_step)
+            .boolean("check_triangles", tri_ok && closed_ok)
             .boolean("check_p50", p50_ok);
         std::fprintf(stderr,
-                     "check: simplified / dense triangles %.4f (within ±%.3g: %s), open edges %.0f vs %.0f; "
-                     "edge/h_dense p50 %.3f, %.3f in [%.2f, %.2f]: %s\n",
+                     "check: simplified / dense triangles %.4f (within ±%.3g: %s), open edges %.0f vs %.0f (%s); "
+                     "edge/h_dense p50 %.3f, %.3f in [%.2f, %.2f], apart by at most %.2f: %s\n",
                      a.triangles > 0 ? b.triangles / a.triangles : NAN, tri_tol, tri_ok ? "yes" : "NO", b.open,
-                     a.open, a.p50, b.p50, p50_lo, p50_hi, p50_ok ? "yes" : "NO");
-        ok = ok && tri_ok && p50_ok;
+                     a.open, closed_ok ? "ok" : "NO: a closed surface came out open", a.p50, b.p50, p50_lo, p50_hi,
+                     p50_step, p50_ok ? "yes" : "NO");
+        ok = ok && tri_ok && closed_ok && p50_ok;
     }
     nglib::Ng_OCC_DeleteGeometry(geo);
     nglib::Ng_Exit();
