@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Turns the JSON lines of the harness programs (bench/paper_tables.sh) into one
-markdown report: models, queries, Hausdorff, decimation, Gmsh meshing (the
-paper's Tables 1-2) and the goals.
+markdown report: models, queries, Hausdorff, decimation, Gmsh and Netgen
+meshing (the paper's Tables 1-2) and the goals.
 
 Usage: paper_tables.py [--mode full|ci] RESULTS_DIR MODEL... > report.md
 RESULTS_DIR/MODEL/ holds report.json (abgs run) and queries_dense.json,
 queries_simplified.json, hausdorff_1t.json, hausdorff_mt.json, decimation.json,
-gmsh.json (one JSON object each; a missing or empty file is reported as such).
+gmsh.json, netgen.json, gcn_report.json, gmsh_gcn.json (one JSON object each; a
+missing or empty file is reported as such).
 """
 import argparse
 import json
@@ -65,7 +66,7 @@ def main():
         d = os.path.join(a.results, m)
         r[m] = {k: load(os.path.join(d, k + ".json")) for k in (
             "report", "queries_dense", "queries_simplified", "hausdorff_1t",
-            "hausdorff_mt", "decimation", "gmsh", "gcn_report", "gmsh_gcn")}
+            "hausdorff_mt", "decimation", "gmsh", "netgen", "gcn_report", "gmsh_gcn")}
     md = []
     machine = ""
     try:
@@ -74,7 +75,7 @@ def main():
             machine = f"{lines[0].strip()}; {lines[1].strip()} cores" if len(lines) > 1 else lines[0]
     except OSError:
         pass
-    md.append("# abgs side by side: CGAL, OpenMesh, Gmsh\n")
+    md.append("# abgs side by side: CGAL, OpenMesh, Gmsh, Netgen\n")
     md.append(f"Mode `{a.mode}`; {platform.machine()}, at the start: {machine}. "
               "Timings are wall clock, best of the repetitions; on a machine shared with other "
               "jobs they are noisy and the all-threads columns show little gain.\n")
@@ -201,7 +202,8 @@ def main():
                          f"{int(calls)}" if calls else "–", num(g[c + "_seconds"], "{:.3f}"),
                          f"{g[c + '_callback_s']:.3f} ({100 * g[c + '_callback_s'] / g[c + '_seconds']:.0f} %)" if calls else "–",
                          f"{1e9 * g[c + '_callback_s'] / calls:.0f}" if calls else "–",
-                         f"{g[c + '_ratio_mean']:.3f} [{g[c + '_ratio_p5']:.2f}, {g[c + '_ratio_p95']:.2f}]"])
+                         f"{g[c + '_ratio_mean']:.3f} [{g[c + '_ratio_p5']:.2f}, "
+                         f"{num(g.get(c + '_ratio_p50'), '{:.2f}')}, {g[c + '_ratio_p95']:.2f}]"])
         for c, label in (("simplified", "simplified grid"), ("stl", "raw STL")):
             p = "field_" + c + "_"
             fields.append([m, label, int(g[p + "faces"]),
@@ -215,13 +217,65 @@ def main():
               "($NodeData `size`), merged into its own model and used as a PostView background field. "
               "Triangles / cell: mesh triangles per background face (what one cell sizes). "
               "Δ: triangles against (a). Edge / h_dense: every mesh edge's length over the dense field at its "
-              "midpoint, mean [p5, p95] (1 = the mesh follows the dense field).\n")
+              "midpoint, mean [p5, p50, p95] (1 = the mesh follows the dense field).\n")
     md.append(table(["model", "background", "triangles", "triangles / cell", "Δ vs (a)", "callback calls", "meshing s",
                      "in callback s", "ns / call", "edge / h_dense"], rows))
     md.append("Background fields against the dense one (`abgs_evaluate`: size deviation at points on the "
               "dense grid, estimated element count change, Hausdorff / diagonal):\n")
     md.append(table(["model", "field", "faces", "size dev mean / p95 / max", "elements vs dense", "Hausdorff / diag"],
                     fields))
+
+    # Netgen beside Gmsh.
+    rows = []
+    for m, x in r.items():
+        n, g = x["netgen"], x["gmsh"] or {}
+        if not n:
+            rows.append([m, "missing"] + ["–"] * 9)
+            continue
+        base = n.get("dense_triangles")
+        for tag, c, label in (("a", "dense", "dense grid"), ("b", "simplified", "simplified grid"),
+                              ("c", "stl", "raw STL")):
+            if n.get(c + "_triangles") is None:
+                continue
+            tri, gtri = n[c + "_triangles"], g.get(c + "_triangles")
+            setup = n[c + "_local_h_s"] + n[c + "_restrict_s"]
+            ratios = lambda d: (f"{d[c + '_ratio_p5']:.2f} / {num(d.get(c + '_ratio_p50'), '{:.2f}')} / "
+                                f"{d[c + '_ratio_p95']:.2f}") if d.get(c + "_ratio_p5") is not None else "–"
+            rows.append([m, f"({tag}) {label} ({int(n[c + '_faces'])} f)",
+                         f"{int(tri)}" + (f" ({pct(tri / base - 1, 1)})" if base and c != "dense" else ""),
+                         f"{int(gtri)}" if gtri else "–",
+                         f"{tri / gtri:.2f}" if gtri else "–",
+                         f"{int(n[c + '_points'])}", num(setup, "{:.2f}"),
+                         f"{num(n[c + '_seconds'], '{:.2f}')} / {num(n.get(c + '_cpu_s'), '{:.2f}')}",
+                         f"{num(g.get(c + '_seconds'), '{:.2f}')} / {num(g.get(c + '_cpu_s'), '{:.2f}')}",
+                         f"{int(n[c + '_open_edges'])}", ratios(n), num(n.get(c + "_own_ratio_p50"), "{:.2f}"),
+                         ratios(g)])
+    md.append("## Real meshing, second mesher: Netgen 6.2 (nglib) surface meshes of the STEP beside Gmsh\n")
+    md.append("Netgen 6.2.1905 (Debian `libnglib-dev`) has no size callback: its size field is an octree of "
+              "cell sizes, lowered by `Ng_RestrictMeshSizePoint(p, h)` (cells around p refined to at most h, "
+              "then graded to the neighbours by h + grading·cell; a restriction within 1.2× of the current "
+              "value is skipped), in 3-D space, not along the surface. Each grid is handed over as points: "
+              "its vertices plus a barycentric lattice per triangle with spacing ≤ 0.5·min(vertex sizes), "
+              "each with the grid's interpolated size. Netgen's own curvature and edge restrictions are off "
+              "(elementspercurve 0, elementsperedge 1e-9, close edges off), maxh = the grid's largest size, "
+              "grading 0.3 (Netgen's default), surface optimisation on; one thread. (The Python module "
+              "python3-netgen cannot do this for STEP: its OCC `GenerateMesh` ignores the MeshingParameters it "
+              "is given.) Triangles with Δ against Netgen's (a); Gmsh's triangles for the same background and "
+              "the ratio Netgen / Gmsh; Netgen setup s = its local-size setup + the restrictions, meshing s = "
+              "edges + surfaces (+ optimisation), wall clock / CPU time of the process (both meshers run one "
+              "thread: on a shared machine CPU time is the steadier number), Gmsh's `generate(2)` beside it; "
+              "the STEP goes to Netgen as a BREP written by Gmsh's OpenCASCADE (Netgen 6.2's STEP reader "
+              "keeps only the first shape of a file: one solid of abc_00000050's three); open edges: mesh edges of one "
+              "triangle (0 on closed solids unless a face failed); edge / h_dense p5 / p50 / p95 of both, and Netgen's "
+              "edge / h_own: against the grid it was given. Netgen's octree keeps about the minimum of the sizes "
+              "given in a cell, so it realises a rougher field finer: the dense grid's field, which varies more "
+              "from vertex to vertex than the simplified one, comes out a few % finer than the simplified "
+              "grid's (h_own p50 lower), where Gmsh, sampling the field pointwise, meshes both alike.\n")
+    md.append(table(["model", "background", "Netgen triangles (Δ vs a)", "Gmsh triangles", "Netgen / Gmsh",
+                     "restriction points", "Netgen setup s", "Netgen meshing s wall / CPU",
+                     "Gmsh meshing s wall / CPU",
+                     "Netgen open edges", "Netgen edge / h_dense p5 / p50 / p95", "Netgen edge / h_own p50",
+                     "Gmsh edge / h_dense p5 / p50 / p95"], rows))
 
     # GCN-ABGS against LBO-ABGS.
     rows = []
@@ -297,6 +351,18 @@ def main():
             rows.append([m, "raw-STL background differs (banding)",
                          f"{pct(s, 1)}; edge/h_dense p5–p95 {gm['stl_ratio_p5']:.2f}–{gm['stl_ratio_p95']:.2f} "
                          f"vs {gm['dense_ratio_p5']:.2f}–{gm['dense_ratio_p95']:.2f}", "shown"])
+        ng = x["netgen"]
+        if ng and ng.get("dense_triangles") and ng.get("simplified_triangles") is not None:
+            d = ng["simplified_triangles"] / ng["dense_triangles"] - 1
+            tol, lo, hi = ng.get("check_triangle_tolerance"), ng.get("check_p50_low"), ng.get("check_p50_high")
+            rows.append([m, f"Netgen triangles, simplified within ±{num(tol and 100 * tol, '{:.0f}')} % of dense "
+                            "(and closed where dense is)",
+                         f"{pct(d, 1)}; open edges {int(ng['simplified_open_edges'])} vs {int(ng['dense_open_edges'])}",
+                         "met" if ng.get("check_triangles") else "missed"])
+            rows.append([m, f"Netgen edge / h_dense p50 within [{num(lo, '{:.2f}')}, {num(hi, '{:.2f}')}], "
+                            f"simplified within {num(ng.get('check_p50_step'), '{:.2f}')} of dense",
+                         f"{ng['dense_ratio_p50']:.3f}, {ng['simplified_ratio_p50']:.3f}",
+                         "met" if ng.get("check_p50") else "missed"])
     md.append("## Goals\n")
     md.append(table(["model", "goal", "measured", "verdict"], rows))
     print("\n".join(md))

@@ -1,35 +1,39 @@
 #!/usr/bin/env bash
 # Side-by-side harness: builds abgs, the CMake harness in cmake/harness (CGAL,
-# OpenMesh, Gmsh) and runs it on models with a STEP, then writes one markdown
-# report (the paper's Tables 1-2 on our models, plus queries, Hausdorff and
-# decimation against CGAL and OpenMesh).
+# OpenMesh, Gmsh, Netgen) and runs it on models with a STEP, then writes one
+# markdown report (the paper's Tables 1-2 on our models with Gmsh and Netgen,
+# plus queries, Hausdorff and decimation against CGAL and OpenMesh).
 #
-# Usage: bench/paper_tables.sh [--ci] [--reuse] [--out FILE] [MODEL ...]
+# Usage: bench/paper_tables.sh [--ci] [--reuse] [--only LIST] [--out FILE] [MODEL ...]
 #   MODEL   a name of ../shared/meshes/MODEL.step with MODEL.stl beside it;
 #           default: every model there that has a STEP
 #   --ci    small and quick: coarser dense grid (--relative 0.02), fewer points
 #           and samples, one timing repetition; checks agreement, not speed
 #   --reuse keep the grids of an earlier run (DIR/MODEL/report.json present)
+#   --only  run only these programs, comma-separated, of: queries, hausdorff,
+#           decimation, gmsh, netgen, gcn (default: all); the report shows the
+#           other programs' results of an earlier run where they are present
 #   --out   the markdown report (default: $ABGS_HARNESS_DIR/paper_tables.md)
 # Environment:
 #   ABGS_HARNESS_DIR   work folder: CMake build, Gmsh venv, results
 #                      (default: target/harness in the repository)
 #   ABGS_HARNESS_VENV  venv holding the pinned gmsh wheel (default: DIR/venv)
 # Installs what is missing when run as root: cmake, g++, libcgal-dev,
-# libopenmesh-dev (apt), gmsh==4.15.2 (pip, in the venv) and the X/GL
-# libraries the Gmsh wheel links to.
+# libopenmesh-dev, libnglib-dev (Netgen 6.2's nglib; apt), gmsh==4.15.2 (pip,
+# in the venv) and the X/GL libraries the Gmsh wheel links to.
 # Exit status: 0 when every program ran and every agreement check passed.
 set -euo pipefail
 
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$repo"
-ci=0 reuse=0 out="" models=()
+ci=0 reuse=0 out="" models=() only=queries,hausdorff,decimation,gmsh,netgen,gcn
 while (($#)); do
   case $1 in
     --ci) ci=1 ;;
     --reuse) reuse=1 ;;
+    --only) only=$2; shift ;;
     --out) out=$2; shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     -*) echo "unknown option $1" >&2; exit 2 ;;
     *) models+=("$1") ;;
   esac
@@ -43,6 +47,10 @@ mkdir -p "$work"
 work=$(cd "$work" && pwd)
 
 step() { printf '\n== %s\n' "$*"; }
+runs() { [[ ,$only, == *,$1,* ]]; }
+for p in ${only//,/ }; do
+  case $p in queries|hausdorff|decimation|gmsh|netgen|gcn) ;; *) echo "unknown program in --only: $p" >&2; exit 2 ;; esac
+done
 apt_install() {
   if [[ $(id -u) -ne 0 ]] || ! command -v apt-get >/dev/null; then
     echo "missing: $*; install them (apt-get install -y $*)" >&2
@@ -61,6 +69,7 @@ command -v c++ >/dev/null || need+=(g++)
 command -v python3 >/dev/null || need+=(python3 python3-venv)
 [[ -f /usr/include/CGAL/AABB_tree.h ]] || need+=(libcgal-dev)
 [[ -f /usr/include/OpenMesh/Tools/Decimater/DecimaterT.hh ]] || need+=(libopenmesh-dev)
+if runs netgen; then [[ -f /usr/include/netgen/nglib.h ]] || need+=(libnglib-dev); fi
 ((${#need[@]} == 0)) || apt_install "${need[@]}"
 gmsh_lib() { compgen -G "$venv/lib/libgmsh.so*" | head -1 || true; }
 if [[ -z $(gmsh_lib) || ! -f $venv/include/gmshc.h ]]; then
@@ -126,22 +135,38 @@ for m in "${models[@]}"; do
   else
     "$abgs" run "$stl" -o "$dir" --no-images "${run_args[@]}" 2>&1 | tail -3
   fi
-  for g in dense simplified; do
-    run_prog "queries_$g" "$dir" "$bin/compare_queries" "$dir/$g.vtk" --points "$points" --reps "$reps"
-  done
-  RAYON_NUM_THREADS=1 run_prog hausdorff_1t "$dir" \
-    "$bin/compare_hausdorff" "$dir/dense.vtk" "$dir/simplified.vtk" --samples "$samples"
-  run_prog hausdorff_mt "$dir" "$bin/compare_hausdorff" "$dir/dense.vtk" "$dir/simplified.vtk" --samples "$samples"
-  run_prog decimation "$dir" "$bin/compare_decimation" "$dir/dense.vtk" "$dir/simplified.vtk" --samples "$samples"
-  run_prog gmsh "$dir" "$bin/gmsh_mesh" "$step_file" --dense "$dir/dense.vtk" \
-    --simplified "$dir/simplified.vtk" --stl "$stl" --samples "$samples"
+  if runs queries; then
+    for g in dense simplified; do
+      run_prog "queries_$g" "$dir" "$bin/compare_queries" "$dir/$g.vtk" --points "$points" --reps "$reps"
+    done
+  fi
+  if runs hausdorff; then
+    RAYON_NUM_THREADS=1 run_prog hausdorff_1t "$dir" \
+      "$bin/compare_hausdorff" "$dir/dense.vtk" "$dir/simplified.vtk" --samples "$samples"
+    run_prog hausdorff_mt "$dir" "$bin/compare_hausdorff" "$dir/dense.vtk" "$dir/simplified.vtk" --samples "$samples"
+  fi
+  if runs decimation; then
+    run_prog decimation "$dir" "$bin/compare_decimation" "$dir/dense.vtk" "$dir/simplified.vtk" --samples "$samples"
+  fi
+  if runs gmsh; then
+    run_prog gmsh "$dir" "$bin/gmsh_mesh" "$step_file" --dense "$dir/dense.vtk" \
+      --simplified "$dir/simplified.vtk" --stl "$stl" --samples "$samples"
+  fi
+  # Netgen (nglib) on the same STEP with the same three grids as restriction
+  # points; the agreement check (simplified against dense) sets its exit status.
+  if runs netgen; then
+    run_prog netgen "$dir" "$bin/netgen_mesh" "$step_file" --dense "$dir/dense.vtk" \
+      --simplified "$dir/simplified.vtk" --stl "$stl" --check
+  fi
   # GCN-ABGS (the embedded model) on the same dense grid, defaults, and the
   # same Gmsh program on its grid (dense and STL rows repeat as anchors).
-  printf -- '-- gcn\n'
-  "$abgs" simplify "$dir/dense.vtk" --method gcn -o "$dir/gcn.vtk" --report "$dir/gcn_report.json" 2>&1 | tail -1 \
-    || { echo "FAILED: gcn" >&2; failed+=("$m/gcn"); }
-  run_prog gmsh_gcn "$dir" "$bin/gmsh_mesh" "$step_file" --dense "$dir/dense.vtk" \
-    --simplified "$dir/gcn.vtk" --stl "$stl" --samples "$samples"
+  if runs gcn; then
+    printf -- '-- gcn\n'
+    "$abgs" simplify "$dir/dense.vtk" --method gcn -o "$dir/gcn.vtk" --report "$dir/gcn_report.json" 2>&1 | tail -1 \
+      || { echo "FAILED: gcn" >&2; failed+=("$m/gcn"); }
+    run_prog gmsh_gcn "$dir" "$bin/gmsh_mesh" "$step_file" --dense "$dir/dense.vtk" \
+      --simplified "$dir/gcn.vtk" --stl "$stl" --samples "$samples"
+  fi
 done
 
 step "report"

@@ -15,44 +15,25 @@
 // are 0 in every case. The callback keeps one hint per thread and counts calls
 // and the time spent inside it (atomics: Gmsh may call it from several threads;
 // General.NumThreads = T, default 1).
-// For each case: triangles, nodes, meshing time, callback calls and time, and
+// For each case: triangles, nodes, meshing time (wall clock and the process's
+// CPU time: one thread, so CPU time is the steadier number on a shared
+// machine), callback calls and time, and
 // how the mesh follows the dense field: edge length / h_dense(midpoint) (mean,
-// 5th and 95th percentiles). The size deviation and estimated element count of
+// 5th, 50th and 95th percentiles). The size deviation and estimated element count of
 // the (b) and (c) fields against the dense one come from abgs_evaluate.
 // When the STEP's extent differs from the grids' by more than a factor 2 (units:
 // a STEP in mm beside an STL in inches), Geometry.OCCScaling is set to the
 // nearest power-of-ten or 25.4 factor.
 // Prints progress on stderr and one JSON object on stdout.
 // Exit status: 0 every case meshed, 1 a case produced no triangles, 2 error.
+#include "gmsh_step.hpp"
 #include "harness.hpp"
-
-extern "C" {  // gmshc.h has no C++ guard of its own
-#include "gmshc.h"
-}
 
 #include <atomic>
 
 using namespace harness;
 
 namespace {
-
-/// Exits with status 2 and Gmsh's last error when a call failed.
-void gcheck(int ierr, const char *what) {
-    if (ierr) {
-        char *msg = nullptr;
-        int e2 = 0;
-        gmshLoggerGetLastError(&msg, &e2);
-        std::fprintf(stderr, "%s failed (%d): %s\n", what, ierr, msg ? msg : "");
-        if (msg) gmshFree(msg);
-        std::exit(2);
-    }
-}
-
-void set_number(const char *name, double v) {
-    int ierr = 0;
-    gmshOptionSetNumber(name, v, &ierr);
-    gcheck(ierr, name);
-}
 
 /// What the size callback measures.
 struct Callback {
@@ -82,28 +63,6 @@ double size_callback(int, int, double x, double y, double z, double lc, void *da
     cb->nanos.fetch_add(static_cast<uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(dt).count()),
                         std::memory_order_relaxed);
     return std::min(h, lc);
-}
-
-/// Imports the STEP into a new model named "cad" (with the OCC scaling set).
-void import_step(const std::string &step) {
-    int ierr = 0;
-    gmshModelAdd("cad", &ierr);
-    gcheck(ierr, "gmshModelAdd");
-    int *dt = nullptr;
-    size_t dt_n = 0;
-    gmshModelOccImportShapes(step.c_str(), &dt, &dt_n, 1, "", &ierr);
-    gcheck(ierr, "gmshModelOccImportShapes");
-    gmshFree(dt);
-    gmshModelOccSynchronize(&ierr);
-    gcheck(ierr, "gmshModelOccSynchronize");
-}
-
-double step_diagonal() {
-    int ierr = 0;
-    double b[6];
-    gmshModelGetBoundingBox(-1, -1, &b[0], &b[1], &b[2], &b[3], &b[4], &b[5], &ierr);
-    gcheck(ierr, "gmshModelGetBoundingBox");
-    return std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) + (b[5] - b[2]) * (b[5] - b[2]));
 }
 
 /// Triangles of the current model's mesh as node coordinates (9 doubles each).
@@ -137,33 +96,6 @@ std::vector<double> mesh_triangles(size_t *n_nodes) {
     gmshFree(etags);
     gmshFree(tnodes);
     return out;
-}
-
-/// Edge length / dense size at the edge midpoint over every triangle edge:
-/// mean, 5th and 95th percentiles.
-std::array<double, 3> follows_field(const Grid &dense, const std::vector<double> &tris) {
-    size_t nt = tris.size() / 9;
-    std::vector<double> mid(9 * nt), len(3 * nt), h(3 * nt);
-    for (size_t t = 0; t < nt; t++)
-        for (int e = 0; e < 3; e++) {
-            const double *a = &tris[9 * t + 3 * e], *b = &tris[9 * t + 3 * ((e + 1) % 3)];
-            double l2 = 0;
-            for (int k = 0; k < 3; k++) {
-                mid[3 * (3 * t + e) + k] = 0.5 * (a[k] + b[k]);
-                l2 += (a[k] - b[k]) * (a[k] - b[k]);
-            }
-            len[3 * t + e] = std::sqrt(l2);
-        }
-    if (nt == 0) return {NAN, NAN, NAN};
-    check(abgs_query_sizes(dense.g, mid.data(), h.size(), h.data()), "abgs_query_sizes");
-    double sum = 0;
-    for (size_t i = 0; i < h.size(); i++) {
-        len[i] /= h[i];
-        sum += len[i];
-    }
-    std::sort(len.begin(), len.end());
-    auto pct = [&](double q) { return len[static_cast<size_t>(q * static_cast<double>(len.size() - 1))]; };
-    return {sum / static_cast<double>(len.size()), pct(0.05), pct(0.95)};
 }
 
 }  // namespace
@@ -221,19 +153,11 @@ int main(int argc, char **argv) {
 
     // Units: compare the STEP's extent with the grids'.
     import_step(step);
-    double occ_scale = 1.0;
-    {
-        double r = dense.stats.diagonal / step_diagonal();
-        // Gmsh's OCC boxes are loose (10-20 % larger than the shape): only a
-        // factor of more than 2 is taken for a unit change.
-        if (std::fabs(std::log(r)) > std::log(2.0)) {
-            double best = 1.0;
-            for (double f : {25.4, 1 / 25.4, 10.0, 0.1, 100.0, 0.01, 1000.0, 0.001})
-                if (std::fabs(std::log(r / f)) < std::fabs(std::log(r / best))) best = f;
-            occ_scale = best;
-            std::fprintf(stderr, "STEP extent / grid extent = %.4g: Geometry.OCCScaling = %.6g\n", 1 / r, occ_scale);
-            set_number("Geometry.OCCScaling", occ_scale);
-        }
+    const double occ_scale = unit_scale(dense.stats.diagonal, step_diagonal());
+    if (occ_scale != 1.0) {
+        std::fprintf(stderr, "STEP extent / grid extent = %.4g: Geometry.OCCScaling = %.6g\n",
+                     step_diagonal() / dense.stats.diagonal, occ_scale);
+        set_number("Geometry.OCCScaling", occ_scale);
     }
     gmshClear(&ierr);
     gcheck(ierr, "gmshClear");
@@ -305,31 +229,34 @@ int main(int argc, char **argv) {
             gcheck(ierr, "gmshModelMeshFieldSetAsBackgroundMesh");
         }
         t0 = now();
+        const double c0 = cpu_now();
         gmshModelMeshGenerate(2, &ierr);
-        const double seconds = now() - t0;
+        const double seconds = now() - t0, cpu = cpu_now() - c0;
         gcheck(ierr, "gmshModelMeshGenerate");
         size_t nodes = 0;
         std::vector<double> tris = mesh_triangles(&nodes);
         const size_t nt = tris.size() / 9;
-        const auto q = follows_field(dense, tris);
+        const EdgeRatio q = EdgeRatio::of(dense, tris);
         const double cb_s = c.grid ? static_cast<double>(cb.nanos.load()) * 1e-9 : 0.0;
         const double calls = c.grid ? static_cast<double>(cb.calls.load()) : 0.0;
         std::string k = c.name;
         out.num(k + "_triangles", static_cast<double>(nt))
             .num(k + "_nodes", static_cast<double>(nodes))
             .num(k + "_seconds", seconds)
+            .num(k + "_cpu_s", cpu)
             .num(k + "_setup_s", setup)
             .num(k + "_calls", calls)
             .num(k + "_callback_s", cb_s)
             .num(k + "_callback_failures", c.grid ? static_cast<double>(cb.failures.load()) : 0.0)
-            .num(k + "_ratio_mean", q[0])
-            .num(k + "_ratio_p5", q[1])
-            .num(k + "_ratio_p95", q[2]);
+            .num(k + "_ratio_mean", q.mean)
+            .num(k + "_ratio_p5", q.p5)
+            .num(k + "_ratio_p50", q.p50)
+            .num(k + "_ratio_p95", q.p95);
         std::fprintf(stderr,
                      "(%s) %-10s %8zu triangles %8zu nodes  meshing %.3f s  callback %.0f calls %.3f s (%.0f ns/call)"
-                     "  edge/h_dense mean %.3f p5 %.3f p95 %.3f%s\n",
+                     "  edge/h_dense mean %.3f p5 %.3f p50 %.3f p95 %.3f%s\n",
                      c.grid ? (c.grid == &dense ? "a" : c.grid == &simp ? "b" : "c") : "d", c.name, nt, nodes,
-                     seconds, calls, cb_s, calls > 0 ? 1e9 * cb_s / calls : 0.0, q[0], q[1], q[2],
+                     seconds, calls, cb_s, calls > 0 ? 1e9 * cb_s / calls : 0.0, q.mean, q.p5, q.p50, q.p95,
                      c.grid ? "" : "  (no callback: PostView background field)");
         if (nt == 0 || (c.grid && cb.failures.load() > 0)) ok = false;
     }

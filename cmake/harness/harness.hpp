@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <map>
 #include <random>
 #include <sstream>
@@ -35,6 +36,11 @@ inline double now() {
     using namespace std::chrono;
     return duration<double>(steady_clock::now().time_since_epoch()).count();
 }
+
+/// CPU seconds of this process, all threads (std::clock): on a machine
+/// shared with other jobs, the single-threaded meshers' CPU time is steadier
+/// than their wall clock.
+inline double cpu_now() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
 using Vec3 = std::array<double, 3>;
 
@@ -130,6 +136,48 @@ struct SurfaceSampler {
             *unit_normal = l > 0 ? mul(n, 1.0 / l) : Vec3{0, 0, 0};
         }
         return add(a, add(mul(sub(b, a), s), mul(sub(c, a), t)));
+    }
+};
+
+/// How a mesh follows a size field: every triangle edge's length over the
+/// field's size at the edge midpoint (1 = the mesh follows the field), mean
+/// and percentiles; `edges` counts edges with their multiplicity (an edge
+/// shared by two triangles counts twice). All NaN for an empty mesh.
+struct EdgeRatio {
+    double mean = NAN, p5 = NAN, p50 = NAN, p95 = NAN;
+    size_t edges = 0;
+
+    /// Measures the triangles `tris` (9 coordinates each) against `field`'s
+    /// sizes (abgs_query_sizes, all threads). O(T log T).
+    static EdgeRatio of(const Grid &field, const std::vector<double> &tris) {
+        EdgeRatio r;
+        const size_t nt = tris.size() / 9;
+        if (nt == 0) return r;
+        std::vector<double> mid(9 * nt), len(3 * nt), h(3 * nt);
+        for (size_t t = 0; t < nt; t++)
+            for (int e = 0; e < 3; e++) {
+                const double *a = &tris[9 * t + 3 * e], *b = &tris[9 * t + 3 * ((e + 1) % 3)];
+                double l2 = 0;
+                for (int k = 0; k < 3; k++) {
+                    mid[3 * (3 * t + e) + k] = 0.5 * (a[k] + b[k]);
+                    l2 += (a[k] - b[k]) * (a[k] - b[k]);
+                }
+                len[3 * t + e] = std::sqrt(l2);
+            }
+        check(abgs_query_sizes(field.g, mid.data(), h.size(), h.data()), "abgs_query_sizes");
+        double sum = 0;
+        for (size_t i = 0; i < h.size(); i++) {
+            len[i] /= h[i];
+            sum += len[i];
+        }
+        std::sort(len.begin(), len.end());
+        auto pct = [&](double q) { return len[static_cast<size_t>(q * static_cast<double>(len.size() - 1))]; };
+        r.mean = sum / static_cast<double>(len.size());
+        r.p5 = pct(0.05);
+        r.p50 = pct(0.5);
+        r.p95 = pct(0.95);
+        r.edges = len.size();
+        return r;
     }
 };
 
