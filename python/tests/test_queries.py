@@ -155,3 +155,31 @@ def test_edge_scores(coarse: abgs.Grid) -> None:
     assert np.all((s["y"] >= 0) & (s["y"] <= 1))
     bad = ~s["valid"]
     assert np.all(s["y"][bad] == 1) and np.all(np.isnan(s["ds"][bad]))
+
+
+def test_bytes_round_trip(coarse: abgs.Grid, points: np.ndarray) -> None:
+    """to_bytes / from_bytes (what an MPI rank broadcasts): the same arrays and
+    the same answers bit for bit; the bytes depend only on the grid; a
+    corrupted byte is refused with a ParseError, never garbage."""
+    data = coarse.to_bytes()
+    assert data == coarse.to_bytes()
+    back = abgs.Grid.from_bytes(data)
+    np.testing.assert_array_equal(back.vertices, coarse.vertices)
+    np.testing.assert_array_equal(back.triangles, coarse.triangles)
+    np.testing.assert_array_equal(back.sizes, coarse.sizes)
+    np.testing.assert_array_equal(back.sizes_at(points), coarse.sizes_at(points))
+    assert back.to_bytes() == data
+    bad = bytearray(data)
+    bad[len(bad) // 2] ^= 0x40
+    try:
+        abgs.Grid.from_bytes(bad)
+    except abgs.AbgsError as e:
+        assert e.status != 0
+    else:
+        raise AssertionError("a corrupted byte was accepted")
+    try:
+        abgs.Grid.from_bytes(data[:10])
+    except abgs.AbgsError:
+        pass
+    else:
+        raise AssertionError("truncated bytes were accepted")

@@ -468,6 +468,8 @@ _PROTOTYPES: dict[str, list[Any]] = {
     "abgs_grid_copy_triangles": [_GRID, _PU32, c_size_t],
     "abgs_grid_copy_sizes": [_GRID, _PD, c_size_t],
     "abgs_grid_free": [_GRID],
+    "abgs_grid_serialize": [_GRID, c_void_p, c_size_t, _PSZ],
+    "abgs_grid_deserialize": [c_void_p, c_size_t, POINTER(_GRID)],
     "abgs_eval_params_default": [POINTER(EvalParams)],
     "abgs_evaluate": [_GRID, _GRID, POINTER(EvalParams), POINTER(Evaluation)],
     "abgs_hausdorff": [_GRID, _GRID, c_uint64, c_uint64, _PD],
