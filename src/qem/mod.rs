@@ -14,7 +14,7 @@
 //!   A collapse gives the kept vertex the sum of both quadrics.
 //! - **Placement.** An edge between two free vertices (on no feature) goes to
 //!   the point minimising its quadric when the 3×3 system is well conditioned
-//!   (solved in f64; the point must also lie within one edge length of the
+//!   (solved in f64 by nalgebra's LU; the point must also lie within one edge length of the
 //!   edge's midpoint), else to the cheapest of its ends and its midpoint.
 //!   Otherwise one end stays where it is: a free vertex may be removed into any
 //!   neighbour, a vertex on a feature line only into a neighbour along a
@@ -52,6 +52,7 @@ use crate::mesh::halfedge::{
     HalfedgeMesh, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED,
 };
 use crate::mesh::{BuildOptions, Features, Grid};
+use nalgebra::{Matrix3, Vector3};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::time::Instant;
@@ -151,24 +152,16 @@ impl Quadric {
     /// product of its two smaller eigenvalues relative to the largest).
     fn optimum(&self) -> Option<[f64; 3]> {
         let [a00, a01, a02, a11, a12, a22] = self.a;
-        let c00 = a11 * a22 - a12 * a12;
-        let c01 = a02 * a12 - a01 * a22;
-        let c02 = a01 * a12 - a02 * a11;
-        let det = a00 * c00 + a01 * c01 + a02 * c02;
-        let tr = (a00 + a11 + a22) / 3.0;
+        let a = Matrix3::new(a00, a01, a02, a01, a11, a12, a02, a12, a22);
+        let det = a.determinant();
+        let tr = a.trace() / 3.0;
         if !(det.is_finite() && tr > 0.0 && det.abs() > 1e-10 * tr * tr * tr) {
             return None;
         }
-        let c11 = a00 * a22 - a02 * a02;
-        let c12 = a01 * a02 - a00 * a12;
-        let c22 = a00 * a11 - a01 * a01;
-        let r = [-self.b[0], -self.b[1], -self.b[2]];
-        let x = [
-            (c00 * r[0] + c01 * r[1] + c02 * r[2]) / det,
-            (c01 * r[0] + c11 * r[1] + c12 * r[2]) / det,
-            (c02 * r[0] + c12 * r[1] + c22 * r[2]) / det,
-        ];
-        x.iter().all(|t| t.is_finite()).then_some(x)
+        let x = a.lu().solve(&-Vector3::from(self.b))?;
+        x.iter()
+            .all(|t| t.is_finite())
+            .then_some([x[0], x[1], x[2]])
     }
 }
 

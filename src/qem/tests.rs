@@ -394,3 +394,68 @@ fn quadric_optimum_and_fallback() {
     let single = Quadric::plane([0.0, 0.0, 1.0], -1.0, 1.0);
     assert!(single.optimum().is_none());
 }
+
+/// The cofactor solve the optimum used before nalgebra.
+fn cofactor_optimum(q: &Quadric) -> Option<[f64; 3]> {
+    let [a00, a01, a02, a11, a12, a22] = q.a;
+    let c00 = a11 * a22 - a12 * a12;
+    let c01 = a02 * a12 - a01 * a22;
+    let c02 = a01 * a12 - a02 * a11;
+    let det = a00 * c00 + a01 * c01 + a02 * c02;
+    let tr = (a00 + a11 + a22) / 3.0;
+    if !(det.is_finite() && tr > 0.0 && det.abs() > 1e-10 * tr * tr * tr) {
+        return None;
+    }
+    let c11 = a00 * a22 - a02 * a02;
+    let c12 = a01 * a02 - a00 * a12;
+    let c22 = a00 * a11 - a01 * a01;
+    let r = [-q.b[0], -q.b[1], -q.b[2]];
+    Some([
+        (c00 * r[0] + c01 * r[1] + c02 * r[2]) / det,
+        (c01 * r[0] + c11 * r[1] + c12 * r[2]) / det,
+        (c02 * r[0] + c12 * r[1] + c22 * r[2]) / det,
+    ])
+}
+
+#[test]
+fn optimum_equals_the_cofactor_solve() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let mut solved = 0;
+    for _ in 0..2000 {
+        // A sum of a few random planes: positive semi-definite, as in decimation.
+        let mut q = Quadric::default();
+        for _ in 0..rng.gen_range(2..6) {
+            let n = [0, 1, 2].map(|_| rng.gen_range(-1.0..1.0));
+            let l = norm(n);
+            let n = scale(n, 1.0 / l);
+            q = q.add(&Quadric::plane(
+                n,
+                rng.gen_range(-2.0..2.0),
+                rng.gen_range(0.1..3.0),
+            ));
+        }
+        let (a, b) = (q.optimum(), cofactor_optimum(&q));
+        assert_eq!(a.is_some(), b.is_some());
+        if let (Some(a), Some(b)) = (a, b) {
+            // Relative to the solution's size, scaled by the conditioning
+            // the test admits (det above 1e-10 of (trace/3)³): within 1e-12
+            // for the well-conditioned ones.
+            let m = norm(b).max(1.0);
+            let err = norm(sub(a, b)) / m;
+            let tr = q.a[0] + q.a[3] + q.a[5];
+            let cond = tr * tr * tr / 27.0 / cofactor_det(&q).abs();
+            assert!(err <= 1e-12 * cond.max(1.0), "{a:?} vs {b:?} (cond {cond})");
+            if cond < 1e3 {
+                assert!(err <= 1e-12, "{a:?} vs {b:?}");
+                solved += 1;
+            }
+        }
+    }
+    assert!(solved > 500, "{solved}");
+}
+
+fn cofactor_det(q: &Quadric) -> f64 {
+    let [a00, a01, a02, a11, a12, a22] = q.a;
+    a00 * (a11 * a22 - a12 * a12) + a01 * (a02 * a12 - a01 * a22) + a02 * (a01 * a12 - a02 * a11)
+}
