@@ -150,7 +150,7 @@ impl Grid {
     /// within `reach` of `p`, as (triangle, barycentric coordinates): the
     /// nearest such body first, then the nearest of the rest, and so on, up
     /// to `MAX_TIED_BODIES − 1` bodies. The one search behind the tie rule,
-    /// the simplifier's agreed sizes and the interface pass. O(log F + k)
+    /// and the simplifier's agreed sizes. O(log F + k)
     /// per body found (k faces within `reach`).
     pub(crate) fn other_bodies_within(
         &self,

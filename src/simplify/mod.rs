@@ -28,7 +28,6 @@
 
 pub mod envelope;
 pub mod estimate;
-pub mod interface;
 mod repair;
 pub mod scorer;
 pub mod select;
@@ -591,8 +590,7 @@ pub(crate) fn run_loop(
         })?;
     }
     report.binding = census(&mesh, &target, &lim);
-    let mut out = finish(&mesh)?;
-    interface::unify(&mut out)?;
+    let out = finish(&mesh)?;
     report.faces_out = out.triangles().len();
     report.vertices_out = out.vertices().len();
     report.seconds = start.elapsed().as_secs_f64();
