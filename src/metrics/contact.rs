@@ -4,8 +4,8 @@
 //!
 //! A sample `p` of the reference surface (on reference body `A`) is a
 //! **contact sample** when a face of another reference body lies within the
-//! contact distance `c` of it (`c` = [`CONTACT_FRACTION`] of the reference's
-//! diagonal, the sizing's default contact gap). Its **partners** are every
+//! contact distance `c` of it (`c` = [`Grid::contact_gap`], diagonal / 2000:
+//! the gap of the queries' tie rule and of the simplifier's agreed sizes). Its **partners** are every
 //! body with a face within `c` of `p` (found one at a time, closest first,
 //! each excluding the bodies found before: at most [`MAX_BODIES`]).
 //!
@@ -28,7 +28,6 @@ use crate::error::{Error, Result};
 use crate::mesh::stats::percentile;
 use crate::mesh::Grid;
 use crate::sampling::surface_points;
-use crate::simplify::envelope::CONTACT_FRACTION;
 use rayon::prelude::*;
 
 /// Most bodies considered at one contact sample.
@@ -87,7 +86,7 @@ pub(crate) fn contact_samples(
     if topo.body_count < 2 || samples == 0 {
         return (Vec::new(), samples);
     }
-    let gap = reference.bbox().diagonal() * CONTACT_FRACTION;
+    let gap = reference.contact_gap();
     let body = &topo.face_body;
     let pts = surface_points(reference, samples, seed);
     let found: Vec<ContactSample> = pts

@@ -30,7 +30,6 @@ use crate::geometry::{closest_point_triangle, triangle_area, Aabb};
 use crate::mesh::stats::percentile;
 use crate::mesh::Grid;
 use crate::sampling::surface_points;
-use crate::simplify::envelope::CONTACT_FRACTION;
 pub use contact::ContactAgreement;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -201,7 +200,7 @@ pub fn evaluate(reference: &Grid, candidate: &Grid, params: &EvalParams) -> Resu
 /// barycentric coordinates on its own reference triangle, `h_c` the candidate's
 /// surface query ([`Grid::closest`]). Equal sizes give exactly 1. Also the
 /// share of those queries that land on the wrong sheet (see [`sheets`]; the
-/// contact distance is [`CONTACT_FRACTION`] of the reference's diagonal).
+/// contact distance is [`Grid::contact_gap`] of the reference).
 ///
 /// Errors when a grid has no sizes or triangles, when `samples` is 0, or when a
 /// size that is not finite and > 0 is met. Parallel, deterministic.
@@ -226,11 +225,7 @@ pub fn size_deviation(
         .into_iter()
         .map(|i| pts[i as usize])
         .collect();
-    let sheets = sheets::Sheets::new(
-        reference,
-        candidate,
-        reference.bbox().diagonal() * CONTACT_FRACTION,
-    );
+    let sheets = sheets::Sheets::new(reference, candidate, reference.contact_gap());
     let wrong = std::sync::atomic::AtomicUsize::new(0);
     let mut ratios: Vec<f64> = pts
         .par_chunks(SAMPLE_CHUNK)

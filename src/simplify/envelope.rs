@@ -163,7 +163,7 @@ impl Envelope {
                     term.factor() * h / kappa
                 })
                 .collect();
-            let contact = grid.bbox().diagonal() * CONTACT_FRACTION;
+            let contact = grid.contact_gap();
             let c = proximity::clearances(grid, &normals, contact, &limit);
             t.par_iter()
                 .enumerate()
