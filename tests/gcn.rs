@@ -235,3 +235,36 @@ fn a_model_that_cannot_run_is_an_error() {
     .unwrap();
     assert!(s.report.faces_out < s.report.faces_in);
 }
+
+#[test]
+fn the_tail_goes_on_where_the_model_stops_and_keeps_the_field() {
+    use abgs::gcn::{embedded_model, Learned};
+    let g = sized_sphere(4);
+    let model = embedded_model().unwrap();
+    let run = |tail: bool| {
+        let mut scorer = Learned::new(model);
+        scorer.tail = tail;
+        let s = abgs::simplify::simplify_with(&g, &gcn_params(false), &mut scorer, None).unwrap();
+        (s, scorer.tail_checks)
+    };
+    let (without, no_checks) = run(false);
+    let (with, checks) = run(true);
+    assert_eq!(no_checks, 0);
+    assert!(checks > 0, "the tail made no accurate estimate");
+    // Both runs are the same until the model's choices run out, where the
+    // run without the tail stops; the tail then removes more.
+    assert!(
+        with.report.faces_out < without.report.faces_out,
+        "tail {} faces, without {}",
+        with.report.faces_out,
+        without.report.faces_out
+    );
+    let ep = abgs::metrics::EvalParams {
+        samples: 20_000,
+        hausdorff_samples: 20_000,
+        ..Default::default()
+    };
+    let e = abgs::metrics::evaluate(&g, &with.grid, &ep).unwrap();
+    assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);
+    assert_eq!(euler(&with.grid), 2);
+}
