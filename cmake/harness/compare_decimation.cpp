@@ -27,7 +27,6 @@
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #pragma GCC diagnostic pop
 
-#include <unordered_map>
 
 using namespace harness;
 
@@ -81,17 +80,32 @@ int main(int argc, char **argv) {
     double t0 = now();
     const Bodies bodies = Bodies::of(dense);
     TriMesh mesh;
-    std::unordered_map<uint64_t, TriMesh::VertexHandle> copy;  // (body, vertex) -> handle
+    // The (vertex, body) pairs in vertex order, each an OpenMesh vertex: on a
+    // grid of one body, vertex i is OpenMesh's vertex i, as without bodies
+    // (the decimation's result depends on the order). A vertex of no face
+    // keeps its place too.
+    std::vector<uint64_t> pairs;
+    pairs.reserve(3 * dense.triangles() + dense.vertices());
+    for (size_t f = 0; f < dense.triangles(); f++)
+        for (int k = 0; k < 3; k++) pairs.push_back(static_cast<uint64_t>(dense.tri[3 * f + k]) << 32 | bodies.face[f]);
+    {
+        std::vector<bool> used(dense.vertices(), false);
+        for (uint32_t v : dense.tri) used[v] = true;
+        for (size_t v = 0; v < dense.vertices(); v++)
+            if (!used[v]) pairs.push_back(static_cast<uint64_t>(v) << 32 | UINT32_MAX);
+    }
+    std::sort(pairs.begin(), pairs.end());
+    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
     auto point = [&](uint32_t v) { return TriMesh::Point(dense.xyz[3 * v], dense.xyz[3 * v + 1], dense.xyz[3 * v + 2]); };
+    for (uint64_t p : pairs) mesh.add_vertex(point(static_cast<uint32_t>(p >> 32)));
+    auto handle = [&](uint32_t v, uint32_t body) {
+        const uint64_t key = static_cast<uint64_t>(v) << 32 | body;
+        return TriMesh::VertexHandle(static_cast<int>(std::lower_bound(pairs.begin(), pairs.end(), key) - pairs.begin()));
+    };
     size_t dropped = 0, isolated = 0;
     for (size_t f = 0; f < dense.triangles(); f++) {
         TriMesh::VertexHandle h[3];
-        for (int k = 0; k < 3; k++) {
-            const uint32_t v = dense.tri[3 * f + k];
-            auto [it, fresh] = copy.try_emplace(static_cast<uint64_t>(bodies.face[f]) << 32 | v);
-            if (fresh) it->second = mesh.add_vertex(point(v));
-            h[k] = it->second;
-        }
+        for (int k = 0; k < 3; k++) h[k] = handle(dense.tri[3 * f + k], bodies.face[f]);
         if (mesh.add_face(h[0], h[1], h[2]).is_valid()) continue;
         for (int k = 0; k < 3; k++) h[k] = mesh.add_vertex(point(dense.tri[3 * f + k]));
         if (mesh.add_face(h[0], h[1], h[2]).is_valid()) {
@@ -101,7 +115,7 @@ int main(int argc, char **argv) {
             for (auto v : h) mesh.delete_vertex(v);
         }
     }
-    mesh.garbage_collection();
+    if (dropped) mesh.garbage_collection();  // the fresh corners of dropped faces
     const size_t om_vertices = mesh.n_vertices(), om_faces = mesh.n_faces();
     mesh.update_face_normals();
     const double om_build = now() - t0;
