@@ -66,6 +66,26 @@ inline size_t entity_count(int dim) {
     return n / 2;
 }
 
+/// Surfaces of the current model without a triangle after meshing (a
+/// surface Gmsh failed on: on an assembly, each solid's faces are meshed on
+/// their own, touching faces twice). O(surfaces).
+inline size_t empty_surfaces() {
+    int ierr = 0, *dt = nullptr;
+    size_t n = 0, empty = 0;
+    gmshModelGetEntities(&dt, &n, 2, &ierr);
+    gcheck(ierr, "gmshModelGetEntities");
+    for (size_t i = 0; i + 1 < n; i += 2) {
+        size_t *tags = nullptr, tags_n = 0, *nodes = nullptr, nodes_n = 0;
+        gmshModelMeshGetElementsByType(2, &tags, &tags_n, &nodes, &nodes_n, dt[i + 1], 0, 1, &ierr);
+        gcheck(ierr, "gmshModelMeshGetElementsByType");
+        empty += tags_n == 0;
+        gmshFree(tags);
+        gmshFree(nodes);
+    }
+    gmshFree(dt);
+    return empty;
+}
+
 /// Grid units per STEP unit: 1, or, when the extents differ by more than a
 /// factor 2 (OCC boxes are loose, so only a larger factor is a unit change),
 /// the power of ten or 25.4 (inches against mm) nearest to their ratio.

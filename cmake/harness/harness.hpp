@@ -44,13 +44,25 @@ inline double cpu_now() { return static_cast<double>(std::clock()) / CLOCKS_PER_
 
 using Vec3 = std::array<double, 3>;
 
+/// A zeroed abgs struct with its `struct_size` set (the header's growth rule).
+template <class T> T versioned() {
+    T t{};
+    t.struct_size = sizeof(T);
+    return t;
+}
+
+/// abgs' contact gap as a fraction of the bounding-box diagonal (include/abgs.h,
+/// abgs_query_size: "the contact gap c (diagonal / 2000)"): bodies nearer than
+/// this touch, and the queries' tie rule reads every body within it.
+constexpr double kContactFraction = 1.0 / 2000.0;
+
 /// An abgs grid handle (freed on destruction) with copies of its arrays.
 struct Grid {
     abgs_grid *g = nullptr;
     std::vector<double> xyz;     // 3 per vertex
     std::vector<uint32_t> tri;   // 3 per triangle
     std::vector<double> size;    // 1 per vertex (empty without sizes)
-    abgs_grid_stats stats{sizeof(abgs_grid_stats)};
+    abgs_grid_stats stats = versioned<abgs_grid_stats>();
 
     Grid() = default;
     Grid(const Grid &) = delete;
@@ -88,6 +100,59 @@ struct Grid {
     size_t vertices() const { return xyz.size() / 3; }
     size_t triangles() const { return tri.size() / 3; }
     Vec3 vertex(size_t i) const { return {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; }
+};
+
+/// Bodies as abgs counts them (`abgs_grid_stats::bodies`, the queries' tie
+/// rule): connected components of the triangles joined through manifold edges
+/// (edges of exactly two triangles), numbered 0.. in order of each body's
+/// lowest triangle. The grids `abgs run` writes carry no body ids, so the
+/// harness labels them with the library's definition (`bodies.count` is
+/// checked against the grid's statistics by `Bodies::of`). O(F log F).
+struct Bodies {
+    std::vector<uint32_t> face;  // body of each triangle
+    uint32_t count = 0;
+
+    static Bodies of(const Grid &g) {
+        const size_t nt = g.triangles();
+        std::vector<std::array<uint32_t, 3>> half;  // (min, max, face) per triangle edge
+        half.reserve(3 * nt);
+        for (size_t f = 0; f < nt; f++)
+            for (int k = 0; k < 3; k++) {
+                uint32_t a = g.tri[3 * f + k], b = g.tri[3 * f + (k + 1) % 3];
+                half.push_back({std::min(a, b), std::max(a, b), static_cast<uint32_t>(f)});
+            }
+        std::sort(half.begin(), half.end());
+        std::vector<uint32_t> parent(nt);
+        for (size_t f = 0; f < nt; f++) parent[f] = static_cast<uint32_t>(f);
+        auto find = [&](uint32_t x) {
+            while (parent[x] != x) x = parent[x] = parent[parent[x]];
+            return x;
+        };
+        for (size_t i = 0; i < half.size();) {
+            size_t j = i;
+            std::vector<uint32_t> faces;
+            while (j < half.size() && half[j][0] == half[i][0] && half[j][1] == half[i][1]) {
+                if (faces.empty() || faces.back() != half[j][2]) faces.push_back(half[j][2]);
+                j++;
+            }
+            if (faces.size() == 2) parent[find(faces[0])] = find(faces[1]);
+            i = j;
+        }
+        Bodies b;
+        b.face.resize(nt);
+        std::vector<uint32_t> label(nt, UINT32_MAX);
+        for (size_t f = 0; f < nt; f++) {
+            uint32_t r = find(static_cast<uint32_t>(f));
+            if (label[r] == UINT32_MAX) label[r] = b.count++;
+            b.face[f] = label[r];
+        }
+        if (b.count != g.stats.bodies) {
+            std::fprintf(stderr, "body labelling: %u bodies here, the library counts %llu\n", b.count,
+                         static_cast<unsigned long long>(g.stats.bodies));
+            std::exit(2);
+        }
+        return b;
+    }
 };
 
 inline Vec3 sub(const Vec3 &a, const Vec3 &b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }

@@ -228,7 +228,7 @@ int main(int argc, char **argv) {
     abgs_size_params sp{};
     sp.struct_size = sizeof sp;
     check(abgs_size_params_default(&sp), "abgs_size_params_default");
-    abgs_size_report sr{sizeof(abgs_size_report)};
+    abgs_size_report sr = versioned<abgs_size_report>();
     double t0 = now();
     check(abgs_compute_size(stl.g, &sp, &sr), "abgs_compute_size (STL)");
     const double stl_size_seconds = now() - t0;
