@@ -207,3 +207,54 @@ fn queries_at_a_tie_read_the_smallest_size() {
     let v = g.query_volume([0.5, 0.5, 0.5], 1.2).unwrap().size;
     assert!(v <= lower([0.5, 0.5, 0.5]).min(upper([0.5, 0.5, 0.5])) + 1e-12);
 }
+
+/// The tie rule is keyed on the closest point: a point inside the lower
+/// block, farther from the interface than the contact gap, whose closest
+/// points lie on both blocks' coincident faces, reads the smaller size
+/// whichever face is the nearest, and one under a part of the face that
+/// touches nothing reads the lower block alone.
+#[test]
+fn points_under_a_contact_read_the_agreed_size_at_any_depth() {
+    let lower = |p: [f64; 3]| 0.2 + 0.1 * p[0];
+    let upper = |p: [f64; 3]| 0.1 + 0.2 * p[1];
+    let mut a = Soup::default();
+    a.boxed([0.0, 0.0, 0.0], [1.0, 1.0, 0.5], 8, false, false);
+    let a = with_sizes(&a.grid(), lower);
+    let mut b = Soup::default();
+    b.boxed([0.0, 0.0, 0.5], [1.0, 1.0, 1.0], 7, false, false);
+    let b = with_sizes(&b.grid(), upper);
+    let n = a.vertices().len() as u32;
+    let g = Grid::from_arrays(
+        [a.vertices(), b.vertices()].concat(),
+        a.triangles()
+            .iter()
+            .copied()
+            .chain(b.triangles().iter().map(|t| t.map(|i| i + n)))
+            .collect(),
+        Some([a.sizes().unwrap(), b.sizes().unwrap()].concat()),
+        &abgs::BuildOptions {
+            weld_relative_tolerance: None,
+            orient: false,
+        },
+    )
+    .unwrap();
+    let gap = g.contact_gap();
+    let mut lowered = 0;
+    for k in 0..100 {
+        let x = 0.3 + 0.4 * (k as f64 * 0.618_034).fract();
+        let y = 0.3 + 0.4 * (k as f64 * 0.414_214).fract();
+        // 0.1 below the interface (> 100 contact gaps), nearer to it than
+        // to the block's sides and bottom.
+        let p = [x, y, 0.4];
+        assert!(0.1 > 100.0 * gap);
+        let q = [x, y, 0.5];
+        let want = lower(q).min(upper(q));
+        let got = g.query_size(p).unwrap();
+        assert!((got - want).abs() < 1e-12, "{p:?}: {got} want {want}");
+        lowered += usize::from(upper(q) < lower(q));
+    }
+    assert!(
+        lowered > 20,
+        "the upper block is smaller at {lowered} points"
+    );
+}

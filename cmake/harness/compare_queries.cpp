@@ -11,12 +11,12 @@
 // face counts, however the bodies of an assembly touch),
 // closest_point_and_primitive, then barycentric interpolation of the vertex
 // sizes on that triangle (double), then abgs' tie rule between bodies
-// (include/abgs.h, abgs_query_size) written with CGAL's own queries: when the
-// closest face is within the contact gap c = diagonal / 2000 and faces of
-// other bodies lie within d + c of the point (d its distance; a box query of
-// the tree, then each face's exact closest point), the answer is the smallest
-// of those bodies' sizes, each interpolated at that body's own closest point
-// (nearest bodies first, at most 4). Bodies as the library counts them:
+// (include/abgs.h, abgs_query_size) written with CGAL's own queries: when
+// faces of other bodies lie within the contact gap c = diagonal / 2000 of the
+// closest point q (a box query of the tree, then each face's exact closest
+// point to q), the answer is the smallest of those bodies' sizes, each
+// interpolated at that body's own closest point to q (nearest bodies first,
+// at most 4), at any distance of the query point. Bodies as the library counts them:
 // components through manifold edges (the grids carry no body ids).
 // abgs: abgs_query_size (plain), abgs_query_size_hinted (one hint carried along
 // the sequence), abgs_query_sizes (batch, rayon). Every abgs answer must agree
@@ -26,9 +26,10 @@
 // tie rule's value with one of them taken as the closest. Two kinds of tie are
 // two-valued by definition and allowed: within one body (a point on a medial
 // axis, continuous sizes but two closest points), and across bodies beyond the
-// contact gap (d > c: the rule reads the closest body alone there, and which of
-// two coincident faces is closest is rounding; e.g. points inside the plate of
-// gmsh_bracket_assembly under the block). A tie across bodies within the gap
+// contact gap (d > c: the rule, keyed on the closest point q, gives one answer
+// where the two bodies' faces coincide, but where their facets lie apart, as
+// on faceted curved contacts, the two candidate closest points differ by up to
+// that distance and so do the sizes there). A tie across bodies within the gap
 // is the rule's case and fails, as does every other mismatch (*unexplained*).
 // Points where the rule read two or more bodies are counted (`contacts`), and
 // those where another body lowered the answer (`contacts_lowered`).
@@ -68,12 +69,11 @@ struct Contact {
 /// The CGAL side: a tree over the grid's triangles (a triangle soup: every
 /// face kept, however the bodies touch), the vertex sizes, and abgs' tie rule
 /// between bodies (include/abgs.h, abgs_query_size) written with CGAL's own
-/// queries: where the closest face is within the contact gap c (diagonal /
-/// 2000) and faces of other bodies lie within d + c of the point (d its
-/// distance to the closest face: a box query of the tree, then each face's
-/// exact closest point), the answer is the smallest of those bodies' sizes,
-/// each interpolated at that body's own closest point (the nearest bodies
-/// first, at most 4 in all).
+/// queries: where faces of other bodies lie within the contact gap c
+/// (diagonal / 2000) of the closest point q (a box query of the tree, then
+/// each face's exact closest point to q), the answer is the smallest of those
+/// bodies' sizes, each interpolated at that body's own closest point to q
+/// (the nearest bodies first, at most 4 in all).
 struct CgalSizer {
     const Grid &g;
     std::vector<Triangle> tris;
@@ -114,11 +114,10 @@ struct CgalSizer {
     /// The tie rule (see the struct): `size` on triangle `f` with closest
     /// point `q`, lowered to the other bodies' sizes where they touch.
     double contact(const Point &p, size_t f, const Point &q, double size, Contact *info = nullptr) const {
+        (void)p;
         if (bodies.count < 2) return size;
-        const double d2 = CGAL::squared_distance(q, p);
-        if (d2 > gap * gap) return size;
         thread_local std::vector<std::tuple<double, size_t, Point>> near;
-        within(p, std::sqrt(d2) + gap, near);
+        within(q, gap, near);
         std::sort(near.begin(), near.end(),
                   [](const auto &a, const auto &b) { return std::get<0>(a) < std::get<0>(b) ||
                                                            (std::get<0>(a) == std::get<0>(b) && std::get<1>(a) < std::get<1>(b)); });
@@ -325,9 +324,9 @@ int main(int argc, char **argv) {
         // answer is the tie rule's value with one of the triangles within eps
         // of the nearest distance taken as the closest. A tie within one body
         // (e.g. a point on the medial axis) is two-valued by definition; so is
-        // one across bodies beyond the contact gap (d > c: the rule reads the
-        // nearest body alone, and at coincident faces which one is nearest is
-        // a matter of rounding). A tie across bodies within the gap would be
+        // one across bodies beyond the contact gap where the bodies' facets
+        // lie apart (d > c: the two candidate closest points differ, and so
+        // do the sizes there). A tie across bodies within the gap would be
         // the rule's job: it counts as unexplained, as does everything else.
         double max_rel = 0.0, max_rel_untied = 0.0, max_rel_body_ties = 0.0, min_tie_distance = INFINITY;
         size_t bad = 0, ties = 0, ties_bodies = 0, unexplained = 0, contacts = 0, lowered = 0;

@@ -28,11 +28,12 @@ versioned!(abgs_hit, 72);
 /// Size at `point` (3 doubles): exact closest point on the grid, barycentric
 /// interpolation there. Expected O(log F).
 ///
-/// Ties between bodies: where bodies of an assembly touch, a point within
-/// the contact gap `c` (diagonal / 2000) of the surface that has another
-/// body's face within `d + c` (`d` its distance to the closest face) gets
-/// the smallest of those bodies' sizes, each interpolated at that body's
-/// closest point (at most 4 bodies). Bodies farther apart than `2c` are never
+/// Ties between bodies: where bodies of an assembly touch, a point whose
+/// closest point `q` on the grid has another body's face within the contact
+/// gap `c` (diagonal / 2000) of `q` gets the smallest of those bodies' sizes,
+/// each interpolated at that body's closest point to `q` (at most 4 bodies),
+/// at any distance from the surface: every point whose closest point lies on
+/// a contact reads one agreed size. Bodies farther apart than `c` are never
 /// mixed. The same rule holds for hinted and batch queries; volume queries
 /// (a minimum over the surface) satisfy it by construction.
 /// Errors: NULL, NON_FINITE, NO_SIZES, BUSY (a mutation is running).

@@ -6,17 +6,19 @@
 //!   answer is a function of the point alone.
 //! - **ties between bodies**: where bodies of an assembly touch, a point lies
 //!   on two bodies at once and the mesh there must satisfy both. So when the
-//!   point lies on the surface (its distance `d` to the closest face is at
-//!   most `c` = [`Grid::contact_gap`], diagonal / 2000) and a face of another
-//!   body lies within `d + c` of it, the answer is the smallest of those
-//!   bodies' sizes, each interpolated at that body's own closest point.
-//!   Bodies that are apart are never mixed: a point on one body reads another
-//!   only when that one is within `2c` of it (a contact), and a point farther
-//!   than `c` from every surface reads its closest body alone. Deterministic
-//!   (a minimum), the same for plain, hinted and batch queries; it costs one
-//!   more bounded search per query near the surface of a grid of several
-//!   bodies and nothing on one body. Volume queries (a minimum over the whole
-//!   surface) satisfy it by construction.
+//!   closest point `q` of the query (on a face of body `A`) has a face of
+//!   another body within `c` = [`Grid::contact_gap`] (diagonal / 2000) of it,
+//!   the answer is the smallest of those bodies' sizes, each interpolated at
+//!   that body's own closest point to `q`. The rule is keyed on `q`, not on
+//!   the query point: every point whose closest point lies on a contact reads
+//!   the same agreed size at any distance (a point inside a plate under a
+//!   block, equally near the plate's and the block's coincident faces, gets
+//!   one answer whichever face rounding makes the nearest). Bodies that are
+//!   apart are never mixed: another body counts only within `c` of `q`.
+//!   Deterministic (a minimum), the same for plain, hinted and batch queries;
+//!   on a grid of several bodies it costs one more bounded search (radius
+//!   `c`) per query, and nothing on one body. Volume queries (a minimum over
+//!   the whole surface) satisfy it by construction.
 //! - **hinted**: the same answer, with the search bound seeded by a triangle the
 //!   caller kept from a nearby query (advancing fronts query neighbours).
 //! - **batch**: many points in parallel (rayon), each answer identical to the
@@ -45,13 +47,13 @@ pub struct QueryHit {
     /// Distance from the query point to the surface.
     pub distance: f64,
     /// Interpolated size, lowered by the tie rule between bodies where
-    /// another body is as close (see the module doc; NaN when the grid has
-    /// no sizes).
+    /// another body touches the closest point (see the module doc; NaN when
+    /// the grid has no sizes).
     pub size: f64,
 }
 
-/// Most bodies one surface query reads at a contact (the nearest and up to
-/// three more within the tie tolerance).
+/// Most bodies one surface query reads at a contact (the closest point's
+/// own and up to three more within the contact gap of it).
 pub const MAX_TIED_BODIES: usize = 4;
 
 /// Points per rayon task in batch queries; consecutive points share hints.
@@ -74,9 +76,8 @@ impl Grid {
         let b = hit.closest.bary;
         let size = match self.sizes() {
             Some(s) => self.smallest_at_contact(
-                p,
+                hit.closest.point,
                 hit.triangle,
-                hit.closest.dist2,
                 interpolate(t.map(|v| s[v as usize]), b),
                 s,
             ),
@@ -125,22 +126,18 @@ impl Grid {
             })
     }
 
-    /// The tie rule between bodies (module doc): `size`, the size on the
-    /// closest triangle `tri` at squared distance `d2`, lowered, when
-    /// `√d2 ≤ contact_gap`, to the size of every other body with a face within
-    /// `√d2 + contact_gap` of `p` (at most [`MAX_TIED_BODIES`] bodies in all).
-    /// O(1) on one body or off the surface, O(log F) per body found otherwise.
-    fn smallest_at_contact(&self, p: [f64; 3], tri: u32, d2: f64, size: f64, s: &[f64]) -> f64 {
+    /// The tie rule between bodies (module doc): `size`, the size at the
+    /// closest point `q` on triangle `tri`, lowered to the size of every other
+    /// body with a face within `contact_gap` of `q`, each at its own closest
+    /// point to `q` (at most [`MAX_TIED_BODIES`] bodies in all). O(1) on one
+    /// body, O(log F) plus O(log F) per body found otherwise.
+    fn smallest_at_contact(&self, q: [f64; 3], tri: u32, size: f64, s: &[f64]) -> f64 {
         let topo = self.topology();
         if topo.body_count < 2 {
             return size;
         }
-        let gap = self.contact_gap();
-        if d2 > gap * gap {
-            return size;
-        }
         let own = topo.face_body[tri as usize];
-        self.other_bodies_within(p, own, d2.sqrt() + gap)
+        self.other_bodies_within(q, own, self.contact_gap())
             .iter()
             .map(|&(t, b)| interpolate(self.triangles()[t as usize].map(|v| s[v as usize]), b))
             .fold(size, f64::min)
