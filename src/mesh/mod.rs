@@ -76,6 +76,9 @@ pub struct Grid {
     bvh: Bvh,
     bbox: Aabb,
     report: ValidationReport,
+    /// Per triangle: may another body's face lie within the contact gap of
+    /// it? Computed on first use ([`Grid::contact_faces`]).
+    contact_faces: std::sync::OnceLock<Vec<bool>>,
 }
 
 /// The arrays of a grid once checked, before its adjacency and hierarchy.
@@ -271,6 +274,7 @@ impl Grid {
             topology,
             bvh,
             report,
+            contact_faces: std::sync::OnceLock::new(),
         };
         if let Some(s) = sizes {
             grid.install_sizes(s);
@@ -395,6 +399,11 @@ impl Grid {
     /// Per-node size lower bounds (empty without sizes).
     pub(crate) fn node_min_size(&self) -> &[f64] {
         &self.node_min_size
+    }
+    /// The lazily computed per-triangle contact flags (see
+    /// [`Grid::contact_faces`]).
+    pub(crate) fn contact_faces_cell(&self) -> &std::sync::OnceLock<Vec<bool>> {
+        &self.contact_faces
     }
     /// Bounding box of the vertices.
     pub fn bbox(&self) -> Aabb {

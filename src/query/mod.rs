@@ -130,10 +130,11 @@ impl Grid {
     /// closest point `q` on triangle `tri`, lowered to the size of every other
     /// body with a face within `contact_gap` of `q`, each at its own closest
     /// point to `q` (at most [`MAX_TIED_BODIES`] bodies in all). O(1) on one
-    /// body, O(log F) plus O(log F) per body found otherwise.
+    /// body or on a triangle no other body comes near ([`Grid::contact_faces`]),
+    /// O(log F) plus O(log F) per body found otherwise.
     fn smallest_at_contact(&self, q: [f64; 3], tri: u32, size: f64, s: &[f64]) -> f64 {
         let topo = self.topology();
-        if topo.body_count < 2 {
+        if topo.body_count < 2 || !self.contact_faces()[tri as usize] {
             return size;
         }
         let own = topo.face_body[tri as usize];
@@ -141,6 +142,43 @@ impl Grid {
             .iter()
             .map(|&(t, b)| interpolate(self.triangles()[t as usize].map(|v| s[v as usize]), b))
             .fold(size, f64::min)
+    }
+
+    /// Per triangle: may a face of another body lie within the contact gap
+    /// ([`Grid::contact_gap`]) of some point of it? Conservative (a sphere
+    /// around the triangle, padded by 1e-9 relative, is tested), so a `false`
+    /// is certain: the tie rule and the simplifier's agreed sizes search for
+    /// other bodies only on `true` triangles. Empty for a grid of one body.
+    /// Computed once, on first use: O(F log F), parallel, deterministic.
+    pub fn contact_faces(&self) -> &[bool] {
+        self.contact_faces_cell().get_or_init(|| {
+            use rayon::prelude::*;
+            let topo = self.topology();
+            if topo.body_count < 2 {
+                return Vec::new();
+            }
+            let gap = self.contact_gap();
+            let v = self.vertices();
+            let body = &topo.face_body;
+            self.triangles()
+                .par_iter()
+                .enumerate()
+                .map(|(f, tri)| {
+                    let [a, b, c] = tri.map(|i| v[i as usize]);
+                    let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+                    let r = [a, b, c]
+                        .iter()
+                        .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
+                        .fold(0.0, f64::max);
+                    let own = body[f];
+                    self.bvh()
+                        .closest_filtered_within(m, (r + gap) * (1.0 + 1e-9), |t| {
+                            body[t as usize] != own
+                        })
+                        .is_some()
+                })
+                .collect()
+        })
     }
 
     /// The closest point of `p` on each body other than `own` with a face

@@ -387,7 +387,7 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
             lines,
             seg_sizes,
             envelope,
-            contact: target::contact_faces(grid),
+            contact: grid.contact_faces().to_vec(),
         },
     ))
 }

@@ -15,7 +15,7 @@
 //! [`super::estimate::Limits::t_contact`]). Both bodies then follow one field
 //! closely wherever they touch, whatever their triangles, and so agree with
 //! each other. Which target triangles come near another body is found once
-//! ([`contact_faces`], conservative), so the extra search is paid only there.
+//! ([`Grid::contact_faces`], conservative), so the extra search is paid only there.
 
 use super::envelope::Envelope;
 use super::estimate::Limits;
@@ -55,39 +55,8 @@ pub struct Target<'a> {
     /// Gradient and clearance per target triangle.
     pub envelope: &'a Envelope,
     /// Per target triangle: another body's face may lie within the contact
-    /// gap of it (empty for a single body; see [`contact_faces`]).
+    /// gap of it (empty for a single body; see [`Grid::contact_faces`]).
     pub contact: &'a [bool],
-}
-
-/// Per triangle of `grid`: does a face of another body come within the
-/// contact gap ([`Grid::contact_gap`]) of it? Conservative (a sphere around
-/// the triangle is tested), so a `false` is certain. Empty for a grid of one
-/// body. O(F log F), parallel.
-pub fn contact_faces(grid: &Grid) -> Vec<bool> {
-    use rayon::prelude::*;
-    let topo = grid.topology();
-    if topo.body_count < 2 {
-        return Vec::new();
-    }
-    let gap = grid.contact_gap();
-    let v = grid.vertices();
-    let body = &topo.face_body;
-    grid.triangles()
-        .par_iter()
-        .enumerate()
-        .map(|(f, tri)| {
-            let [a, b, c] = tri.map(|i| v[i as usize]);
-            let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
-            let r = [a, b, c]
-                .iter()
-                .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
-                .fold(0.0, f64::max);
-            let own = body[f];
-            grid.bvh()
-                .closest_filtered_within(m, r + gap, |t| body[t as usize] != own)
-                .is_some()
-        })
-        .collect()
 }
 
 impl Target<'_> {
