@@ -14,8 +14,10 @@
 //! **The fringe.** A triangle that straddles the edge of a contact (a block's
 //! top face running out from under a plate lying on it) has corners on the
 //! interface and corners off it, and its interpolated size inside the
-//! interface mixes both: on `gmsh_bracket_assembly` that alone left the
-//! dense grid's two bodies up to 129 % apart at interface points. So the
+//! interface mixes both (on `gmsh_bracket_assembly` the fringe alone took
+//! the dense grid's disagreement p95 from 4.5 % to 4.1 %; taking every
+//! body within the gap instead of the nearest, where a bolt, a washer and a
+//! plate meet, took its max from 42 % to 17 %). So the
 //! corners off the interface that share a face with a contact vertex (the
 //! fringe) take the same minimum, against the same other body at their own
 //! closest point on it (which lies within the edge to the contact vertex plus
