@@ -148,23 +148,23 @@ fn bodies_apart_are_not_mixed() {
     assert_eq!(s.report.binding.contact, 0);
 }
 
-/// The tie rule: a point on a contact reads the smaller body's size, the
-/// same through plain, hinted and batch queries, and a point beside one body
-/// (farther from the other than the tolerance) reads that body's own size.
-#[test]
-fn queries_at_a_tie_read_the_smallest_size() {
-    // Lower block 0.2 + 0.1·x, upper block 0.1 + 0.2·y: they differ on the
-    // interface z = 0.5, each linear, so interpolation is exact.
-    let lower = |p: [f64; 3]| 0.2 + 0.1 * p[0];
-    let upper = |p: [f64; 3]| 0.1 + 0.2 * p[1];
+/// Lower block's size 0.2 + 0.1·x and upper block's 0.1 + 0.2·y: they
+/// differ on the interface z = 0.5, each linear, so interpolation is exact.
+const LOWER: fn([f64; 3]) -> f64 = |p| 0.2 + 0.1 * p[0];
+const UPPER: fn([f64; 3]) -> f64 = |p| 0.1 + 0.2 * p[1];
+
+/// Two unit blocks stacked at z = 0.5 with coincident faces, triangulated
+/// independently (8 and 7 divisions), not welded, sized by [`LOWER`] and
+/// [`UPPER`].
+fn stacked_blocks() -> Grid {
     let mut a = Soup::default();
     a.boxed([0.0, 0.0, 0.0], [1.0, 1.0, 0.5], 8, false, false);
-    let a = with_sizes(&a.grid(), lower);
+    let a = with_sizes(&a.grid(), LOWER);
     let mut b = Soup::default();
     b.boxed([0.0, 0.0, 0.5], [1.0, 1.0, 1.0], 7, false, false);
-    let b = with_sizes(&b.grid(), upper);
+    let b = with_sizes(&b.grid(), UPPER);
     let n = a.vertices().len() as u32;
-    let g = Grid::from_arrays(
+    Grid::from_arrays(
         [a.vertices(), b.vertices()].concat(),
         a.triangles()
             .iter()
@@ -177,7 +177,16 @@ fn queries_at_a_tie_read_the_smallest_size() {
             orient: false,
         },
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// The tie rule: a point on a contact reads the smaller body's size, the
+/// same through plain, hinted and batch queries, and a point beside one body
+/// (farther from the other than the tolerance) reads that body's own size.
+#[test]
+fn queries_at_a_tie_read_the_smallest_size() {
+    let (lower, upper) = (LOWER, UPPER);
+    let g = stacked_blocks();
     assert_eq!(g.topology().body_count, 2);
     let pts: Vec<[f64; 3]> = (0..200)
         .map(|k| {
@@ -215,29 +224,8 @@ fn queries_at_a_tie_read_the_smallest_size() {
 /// touches nothing reads the lower block alone.
 #[test]
 fn points_under_a_contact_read_the_agreed_size_at_any_depth() {
-    let lower = |p: [f64; 3]| 0.2 + 0.1 * p[0];
-    let upper = |p: [f64; 3]| 0.1 + 0.2 * p[1];
-    let mut a = Soup::default();
-    a.boxed([0.0, 0.0, 0.0], [1.0, 1.0, 0.5], 8, false, false);
-    let a = with_sizes(&a.grid(), lower);
-    let mut b = Soup::default();
-    b.boxed([0.0, 0.0, 0.5], [1.0, 1.0, 1.0], 7, false, false);
-    let b = with_sizes(&b.grid(), upper);
-    let n = a.vertices().len() as u32;
-    let g = Grid::from_arrays(
-        [a.vertices(), b.vertices()].concat(),
-        a.triangles()
-            .iter()
-            .copied()
-            .chain(b.triangles().iter().map(|t| t.map(|i| i + n)))
-            .collect(),
-        Some([a.sizes().unwrap(), b.sizes().unwrap()].concat()),
-        &abgs::BuildOptions {
-            weld_relative_tolerance: None,
-            orient: false,
-        },
-    )
-    .unwrap();
+    let (lower, upper) = (LOWER, UPPER);
+    let g = stacked_blocks();
     let gap = g.contact_gap();
     let mut lowered = 0;
     for k in 0..100 {

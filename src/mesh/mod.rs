@@ -400,11 +400,43 @@ impl Grid {
     pub(crate) fn node_min_size(&self) -> &[f64] {
         &self.node_min_size
     }
-    /// The lazily computed per-triangle contact flags (see
-    /// [`Grid::contact_faces`]).
-    pub(crate) fn contact_faces_cell(&self) -> &std::sync::OnceLock<Vec<bool>> {
-        &self.contact_faces
+    /// Per triangle: may a face of another body lie within the contact gap
+    /// ([`Grid::contact_gap`]) of some point of it? Conservative (a sphere
+    /// around the triangle, padded by 1e-9 relative, is tested), so a `false`
+    /// is certain: the tie rule and the simplifier's agreed sizes search for
+    /// other bodies only on `true` triangles. Empty for a grid of one body.
+    /// Computed once, on first use: O(F log F), parallel, deterministic.
+    pub fn contact_faces(&self) -> &[bool] {
+        self.contact_faces.get_or_init(|| {
+            use rayon::prelude::*;
+            let topo = self.topology();
+            if topo.body_count < 2 {
+                return Vec::new();
+            }
+            let gap = self.contact_gap();
+            let v = self.vertices();
+            let body = &topo.face_body;
+            self.triangles()
+                .par_iter()
+                .enumerate()
+                .map(|(f, tri)| {
+                    let [a, b, c] = tri.map(|i| v[i as usize]);
+                    let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+                    let r = [a, b, c]
+                        .iter()
+                        .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
+                        .fold(0.0, f64::max);
+                    let own = body[f];
+                    self.bvh()
+                        .closest_filtered_within(m, (r + gap) * (1.0 + 1e-9), |t| {
+                            body[t as usize] != own
+                        })
+                        .is_some()
+                })
+                .collect()
+        })
     }
+
     /// Bounding box of the vertices.
     pub fn bbox(&self) -> Aabb {
         self.bbox

@@ -339,7 +339,6 @@ struct TargetParts {
     lines: FeatureLines,
     seg_sizes: Vec<[f64; 2]>,
     envelope: envelope::Envelope,
-    contact: Vec<bool>,
 }
 
 impl TargetParts {
@@ -352,7 +351,7 @@ impl TargetParts {
             lines: &self.lines,
             seg_sizes: &self.seg_sizes,
             envelope: &self.envelope,
-            contact: &self.contact,
+            contact: grid.contact_faces(),
         }
     }
 }
@@ -387,7 +386,6 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
             lines,
             seg_sizes,
             envelope,
-            contact: grid.contact_faces().to_vec(),
         },
     ))
 }

@@ -31,11 +31,9 @@
 use crate::mesh::Grid;
 use rayon::prelude::*;
 
-/// Most other bodies one vertex takes its size from.
-pub const MAX_OTHER_BODIES: usize = 4;
-
 /// A vertex lying on another body's face (within the contact gap); a vertex
-/// on several other bodies has one per body.
+/// on several other bodies has one per body (at most
+/// [`crate::query::MAX_TIED_BODIES`] − 1, as the queries' tie rule).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Contact {
     /// The vertex.
@@ -69,30 +67,19 @@ pub fn contacts(grid: &Grid, gap: f64) -> Vec<Contact> {
         .flat_map_iter(|vi| {
             // A vertex's own body: that of any of its faces (welded bodies
             // are split into components, so all its faces share one body).
-            let mut bodies: Vec<u32> = topo
-                .faces_of_vertex(vi)
-                .first()
-                .map(|&f| body[f as usize])
+            let own = topo.faces_of_vertex(vi).first().map(|&f| body[f as usize]);
+            // Every other body within the gap, nearest first (the tie rule's
+            // search): where three bodies meet, the nearest one alone may not
+            // be the smallest.
+            own.map(|own| grid.other_bodies_within(v[vi], own, gap))
                 .into_iter()
-                .collect();
-            let mut found = Vec::new();
-            // Every other body within the gap, nearest first: where three
-            // bodies meet, the nearest one alone may not be the smallest.
-            while !bodies.is_empty() && bodies.len() <= MAX_OTHER_BODIES {
-                let Some(hit) = bvh
-                    .closest_filtered_within(v[vi], gap, |t| !bodies.contains(&body[t as usize]))
-                else {
-                    break;
-                };
-                bodies.push(body[hit.triangle as usize]);
-                found.push(Contact {
+                .flatten()
+                .map(move |(triangle, bary)| Contact {
                     vertex: vi as u32,
-                    triangle: hit.triangle,
-                    bary: hit.closest.bary,
+                    triangle,
+                    bary,
                     fringe: false,
-                });
-            }
-            found
+                })
         })
         .collect();
     let mut on_contact = vec![false; v.len()];
