@@ -11,6 +11,7 @@ mod dataset;
 mod eval;
 mod grid;
 mod info;
+mod memory;
 mod points;
 mod progress;
 mod query;

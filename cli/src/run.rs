@@ -1,6 +1,7 @@
 //! `abgs run`: the whole pipeline on one surface, dense grid → sizes →
 //! simplification → evaluation, with a report and two pictures.
 
+use crate::memory::Meter;
 use crate::render::{line_chart_png, preview_png, Panel, Series};
 use crate::simplify::{iterations_json, params_json, report_json, run_abgs, write_json, LboArgs};
 use abgs::metrics::{evaluate, EvalParams};
@@ -51,17 +52,20 @@ pub struct RunArgs {
     pub no_images: bool,
 }
 
-fn stage<T>(
-    name: &str,
-    times: &mut Vec<(String, f64)>,
-    f: impl FnOnce() -> Result<T>,
-) -> Result<T> {
+/// Seconds and peak memory of each stage.
+struct Stages {
+    times: Vec<(String, f64)>,
+    memory: Meter,
+}
+
+fn stage<T>(name: &str, stages: &mut Stages, f: impl FnOnce() -> Result<T>) -> Result<T> {
     let pb = crate::progress::spinner(name.to_string());
     let t = Instant::now();
     let r = f();
     pb.finish_and_clear();
     let s = t.elapsed().as_secs_f64();
-    times.push((name.to_string(), s));
+    stages.times.push((name.to_string(), s));
+    stages.memory.end_stage(name);
     if r.is_ok() {
         eprintln!("{name}: {s:.2} s");
     }
@@ -72,15 +76,18 @@ fn stage<T>(
 pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
     std::fs::create_dir_all(&a.output).map_err(|e| Error::io(&a.output, e))?;
     let start = Instant::now();
-    let mut times: Vec<(String, f64)> = Vec::new();
-    let surface = stage("load", &mut times, || Grid::load(input))?;
+    let mut stages = Stages {
+        times: Vec::new(),
+        memory: Meter::new(),
+    };
+    let surface = stage("load", &mut stages, || Grid::load(input))?;
     let rp = RemeshParams {
         target: TargetLength::Relative(a.relative),
         feature_angle_deg: a.feature_angle,
         n_circle: a.n_circle,
         ..Default::default()
     };
-    let remeshed = stage("dense grid", &mut times, || remesh(&surface, &rp))?;
+    let remeshed = stage("dense grid", &mut stages, || remesh(&surface, &rp))?;
     let mut dense = remeshed.grid;
     let sp = SizeParams {
         n_circle: a.n_circle,
@@ -89,7 +96,7 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         gradation: Some(sizing::Gradation::Beta(a.beta)),
         ..Default::default()
     };
-    let fields = stage("sizes", &mut times, || sizing::compute(&dense, &sp))?;
+    let fields = stage("sizes", &mut stages, || sizing::compute(&dense, &sp))?;
     dense.set_sizes(fields.h.clone())?;
     let mut params = a.lbo.params(a.feature_angle, a.beta, true);
     if a.method == "gcn" {
@@ -97,7 +104,10 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
     }
     let t = Instant::now();
     let simplified = run_abgs(&dense, &params, a.lbo.model.as_deref())?;
-    times.push(("simplify".into(), t.elapsed().as_secs_f64()));
+    stages
+        .times
+        .push(("simplify".into(), t.elapsed().as_secs_f64()));
+    stages.memory.end_stage("simplify");
     eprintln!(
         "simplify: {:.2} s ({} -> {} faces, {} iterations)",
         t.elapsed().as_secs_f64(),
@@ -110,17 +120,17 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         hausdorff_samples: a.samples,
         ..Default::default()
     };
-    let eval = stage("evaluate", &mut times, || {
+    let eval = stage("evaluate", &mut stages, || {
         evaluate(&dense, &simplified.grid, &ep)
     })?;
     let dense_path = a.output.join("dense.vtk");
     let simp_path = a.output.join("simplified.vtk");
-    stage("write grids", &mut times, || {
+    stage("write grids", &mut stages, || {
         dense.save(&dense_path)?;
         simplified.grid.save(&simp_path)
     })?;
     let qem = if a.qem {
-        let q = stage("qem baseline", &mut times, || {
+        let q = stage("qem baseline", &mut stages, || {
             decimate(
                 &dense,
                 &QemParams {
@@ -130,7 +140,7 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
                 },
             )
         })?;
-        let qe = stage("evaluate qem", &mut times, || {
+        let qe = stage("evaluate qem", &mut stages, || {
             evaluate(&dense, &q.grid, &ep)
         })?;
         q.grid.save(&a.output.join("qem.vtk"))?;
@@ -139,7 +149,7 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         None
     };
     if !a.no_images {
-        stage("images", &mut times, || {
+        stage("images", &mut stages, || {
             images(&a.output, &dense, &simplified)
         })?;
     }
@@ -178,12 +188,23 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         });
     }
     let total = start.elapsed().as_secs_f64();
-    let mut st: serde_json::Map<String, Value> =
-        times.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
+    let mut st: serde_json::Map<String, Value> = stages
+        .times
+        .iter()
+        .map(|(k, v)| (k.clone(), json!(v)))
+        .collect();
     st.insert("total".into(), json!(total));
     report["seconds"] = Value::Object(st);
+    report["memory"] = stages.memory.json(dense.triangles().len());
     write_json(&a.output.join("report.json"), &report)?;
     print_summary(&eval, qem.as_ref().map(|x| &x.1), total);
+    if let Some(peak) = stages.memory.overall() {
+        eprintln!(
+            "peak memory {:.0} MB ({:.0} bytes per dense face)",
+            peak as f64 / (1 << 20) as f64,
+            peak as f64 / dense.triangles().len().max(1) as f64
+        );
+    }
     Ok(())
 }
 

@@ -676,6 +676,16 @@ fn run_writes_grids_report_and_pictures() {
     ] {
         assert!(r["seconds"][stage].is_number(), "{stage}");
     }
+    if cfg!(target_os = "linux") {
+        let mem = &r["memory"];
+        let peak = mem["peak_rss_bytes"].as_u64().unwrap();
+        for stage in ["dense grid", "sizes", "simplify", "evaluate"] {
+            let s = mem["stage_peak_rss_bytes"][stage].as_u64().unwrap();
+            assert!(0 < s && s <= peak, "{stage}: {s} of {peak}");
+        }
+        let per_face = mem["peak_bytes_per_dense_face"].as_f64().unwrap();
+        assert_eq!(per_face, peak as f64 / dense.triangles().len() as f64);
+    }
     assert!(!r["iterations"].as_array().unwrap().is_empty());
     assert!(r["parameters"]["simplify"]["tau_d"].is_null());
     assert_eq!(r["parameters"]["simplify"]["clearance_fraction"], 0.25);
