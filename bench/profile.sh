@@ -30,12 +30,7 @@ done
 out=${ABGS_PROFILE_DIR:-$repo/target/profile}
 meshes=${ABGS_MESHES:-../shared/meshes}
 mkdir -p "$out"
-if [[ -n ${ABGS_BIN:-} ]]; then
-  abgs=$ABGS_BIN
-else
-  cargo build --release -q -p abgs-cli
-  abgs=$repo/target/release/abgs
-fi
+source "$repo/bench/abgs_bin.sh"
 perf_ok=0
 if command -v perf >/dev/null && perf record -q -o "$out/.probe" -F 99 true 2>/dev/null; then
   perf_ok=1

@@ -31,12 +31,7 @@ done
 out=${ABGS_SCALE_DIR:-$repo/target/scale}
 meshes=${ABGS_MESHES:-../shared/meshes}
 mkdir -p "$out"
-if [[ -n ${ABGS_BIN:-} ]]; then
-  abgs=$ABGS_BIN
-else
-  cargo build --release -q -p abgs-cli
-  abgs=$repo/target/release/abgs
-fi
+source "$repo/bench/abgs_bin.sh"
 runs=()
 one() { # one NAME INPUT [abgs run options...]
   local name=$1 input=$2
