@@ -79,6 +79,10 @@ pub struct Grid {
     /// Per triangle: may another body's face lie within the contact gap of
     /// it? Computed on first use ([`Grid::contact_faces`]).
     contact_faces: std::sync::OnceLock<Vec<bool>>,
+    /// Per BVH node: the body of every triangle below it, or
+    /// [`crate::spatial::MIXED_LABEL`]. Computed on first use
+    /// ([`Grid::node_bodies`]).
+    node_bodies: std::sync::OnceLock<Vec<u32>>,
 }
 
 /// The arrays of a grid once checked, before its adjacency and hierarchy.
@@ -275,6 +279,7 @@ impl Grid {
             bvh,
             report,
             contact_faces: std::sync::OnceLock::new(),
+            node_bodies: std::sync::OnceLock::new(),
         };
         if let Some(s) = sizes {
             grid.install_sizes(s);
@@ -427,14 +432,29 @@ impl Grid {
                         .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
                         .fold(0.0, f64::max);
                     let own = body[f];
+                    let nodes = self.node_bodies();
                     self.bvh()
-                        .closest_filtered_within(m, (r + gap) * (1.0 + 1e-9), |t| {
-                            body[t as usize] != own
-                        })
+                        .closest_filtered_within_pruned(
+                            m,
+                            (r + gap) * (1.0 + 1e-9),
+                            |t| body[t as usize] != own,
+                            |n| nodes[n] != own,
+                        )
                         .is_some()
                 })
                 .collect()
         })
+    }
+
+    /// Per BVH node: the body every triangle below it belongs to, or
+    /// [`crate::spatial::MIXED_LABEL`] where they differ. The searches for
+    /// *other* bodies (the tie rule, [`Grid::contact_faces`]) skip the
+    /// subtrees of bodies they exclude with it: on a point of a body, most
+    /// nodes within reach hold only that body's own faces. Computed once, on
+    /// first use: O(nodes).
+    pub(crate) fn node_bodies(&self) -> &[u32] {
+        self.node_bodies
+            .get_or_init(|| self.bvh.node_labels(&self.topology.face_body))
     }
 
     /// Bounding box of the vertices.

@@ -159,12 +159,15 @@ impl Grid {
         let body = &self.topology().face_body;
         let mut seen = arrayvec::ArrayVec::<u32, MAX_TIED_BODIES>::new();
         seen.push(own);
+        let nodes = self.node_bodies();
         let mut found = arrayvec::ArrayVec::new();
         while !seen.is_full() {
-            let Some(hit) = self
-                .bvh()
-                .closest_filtered_within(p, reach, |t| !seen.contains(&body[t as usize]))
-            else {
+            let Some(hit) = self.bvh().closest_filtered_within_pruned(
+                p,
+                reach,
+                |t| !seen.contains(&body[t as usize]),
+                |n| nodes[n] == crate::spatial::MIXED_LABEL || !seen.contains(&nodes[n]),
+            ) else {
                 break;
             };
             found.push((hit.triangle, hit.closest.bary));

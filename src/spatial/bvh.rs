@@ -22,6 +22,8 @@ const PARALLEL_CUTOFF: usize = 8192;
 const SAH_DEPTH: usize = 60;
 /// Upper bound on the tree depth, so traversal stacks can be fixed arrays.
 pub const MAX_DEPTH: usize = 128;
+/// [`Bvh::node_labels`]' label of a node whose triangles' labels differ.
+pub const MIXED_LABEL: u32 = u32::MAX;
 
 /// One node of the flattened tree (one cache line).
 #[derive(Debug, Clone, Copy)]
@@ -207,7 +209,7 @@ impl Bvh {
         hint: Option<u32>,
         keep: impl Fn(u32) -> bool,
     ) -> Option<ClosestHit> {
-        self.search(p, hint, f64::INFINITY, keep)
+        self.search(p, hint, f64::INFINITY, keep, |_| true)
     }
 
     /// [`Bvh::closest_filtered`] restricted to distances below `max_distance`
@@ -220,7 +222,54 @@ impl Bvh {
         max_distance: f64,
         keep: impl Fn(u32) -> bool,
     ) -> Option<ClosestHit> {
-        self.search(p, None, max_distance * max_distance, keep)
+        self.search(p, None, max_distance * max_distance, keep, |_| true)
+    }
+
+    /// [`Bvh::closest_filtered_within`] that also skips every node for which
+    /// `keep_node(node)` is false: the caller's promise that `keep` accepts
+    /// no triangle below it (e.g. a node whose triangles all belong to an
+    /// excluded body, [`Bvh::node_labels`]), so the answer is the same and
+    /// only the time changes. O(log F + k) for k accepted triangles within
+    /// reach and the nodes not pruned.
+    pub fn closest_filtered_within_pruned(
+        &self,
+        p: [f64; 3],
+        max_distance: f64,
+        keep: impl Fn(u32) -> bool,
+        keep_node: impl Fn(usize) -> bool,
+    ) -> Option<ClosestHit> {
+        self.search(p, None, max_distance * max_distance, keep, keep_node)
+    }
+
+    /// For per-triangle labels `tri_label` (a body, say), the label shared by
+    /// every triangle below each node, or [`MIXED_LABEL`] where they differ.
+    /// O(nodes).
+    pub fn node_labels(&self, tri_label: &[u32]) -> Vec<u32> {
+        let mut out = vec![MIXED_LABEL; self.nodes.len()];
+        // Children come after their parent: a reverse sweep sees children first.
+        for i in (0..self.nodes.len()).rev() {
+            let n = &self.nodes[i];
+            out[i] = if n.is_leaf() {
+                let s = n.start as usize;
+                let mut labels = self.prim_triangle[s..s + n.count as usize]
+                    .iter()
+                    .map(|&t| tri_label[t as usize]);
+                let first = labels.next().unwrap_or(MIXED_LABEL);
+                if labels.all(|l| l == first) {
+                    first
+                } else {
+                    MIXED_LABEL
+                }
+            } else {
+                let (l, r) = (out[i + 1], out[n.start as usize]);
+                if l == r {
+                    l
+                } else {
+                    MIXED_LABEL
+                }
+            };
+        }
+        out
     }
 
     /// Branch and bound from the bound `bound2` (squared distance), seeded by
@@ -231,6 +280,7 @@ impl Bvh {
         hint: Option<u32>,
         bound2: f64,
         keep: impl Fn(u32) -> bool,
+        keep_node: impl Fn(usize) -> bool,
     ) -> Option<ClosestHit> {
         if self.nodes.is_empty() {
             return None;
@@ -242,7 +292,7 @@ impl Bvh {
             best.offer(h, closest_point_triangle(p, c[0], c[1], c[2]));
         }
         if self.nodes[0].bbox.distance2(&p) <= best.limit {
-            self.descend(&p, &mut best, &keep);
+            self.descend(&p, &mut best, &keep, &keep_node);
         }
         (best.tri != u32::MAX).then_some(ClosestHit {
             triangle: best.tri,
@@ -344,13 +394,21 @@ impl Bvh {
     }
 
     /// Top-down search from the root (whose box the caller checked).
-    fn descend(&self, p: &[f64; 3], best: &mut Best, keep: &impl Fn(u32) -> bool) {
+    fn descend(
+        &self,
+        p: &[f64; 3],
+        best: &mut Best,
+        keep: &impl Fn(u32) -> bool,
+        keep_node: &impl Fn(usize) -> bool,
+    ) {
         // Uninitialised storage: zeroing a fixed array costs more than the walk.
         let mut stack: ArrayVec<(u32, f64), MAX_DEPTH> = ArrayVec::new();
         let mut node = 0usize;
         loop {
             let n = &self.nodes[node];
-            if n.is_leaf() {
+            if !keep_node(node) {
+                // Nothing below is accepted: pop the next node.
+            } else if n.is_leaf() {
                 self.scan_leaf(node, p, best, keep);
             } else {
                 let (near, dn, far, df) = self.children_by_distance(node, p);
@@ -674,6 +732,44 @@ mod tests {
             if !n.is_leaf() {
                 assert_eq!(m[i], m[i + 1].min(m[n.start as usize]));
             }
+        }
+    }
+
+    #[test]
+    fn pruning_excluded_labels_keeps_every_answer() {
+        let (v, t) = random_soup(2000, 5);
+        let bvh = Bvh::build(&v, &t);
+        // Labels by region (as bodies are), with a few scattered ones.
+        let label: Vec<u32> = (0..t.len())
+            .map(|i| {
+                let c = v[t[i][0] as usize];
+                if i % 97 == 0 {
+                    3
+                } else {
+                    (c[0] * 3.0) as u32
+                }
+            })
+            .collect();
+        let nodes = bvh.node_labels(&label);
+        for (i, n) in bvh.nodes.iter().enumerate() {
+            if nodes[i] != MIXED_LABEL && n.is_leaf() {
+                let s = n.start as usize;
+                for &tri in &bvh.prim_triangle[s..s + n.count as usize] {
+                    assert_eq!(label[tri as usize], nodes[i]);
+                }
+            }
+        }
+        assert!(nodes.iter().any(|&l| l != MIXED_LABEL));
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+        for _ in 0..400 {
+            let p = [rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()];
+            let own = rng.gen_range(0..4u32);
+            let reach = 0.3 * rng.gen::<f64>();
+            let keep = |t: u32| label[t as usize] != own;
+            assert_eq!(
+                bvh.closest_filtered_within_pruned(p, reach, keep, |n| nodes[n] != own),
+                bvh.closest_filtered_within(p, reach, keep)
+            );
         }
     }
 }
