@@ -87,7 +87,7 @@ for m in models:
             for l in open(top).read().splitlines()[:6]:
                 pct, sym = l.split(None, 1)
                 sym = sym.split("] ", 1)[-1].strip()
-                funcs.append(f"{pct} {sym.strip()[:60].strip()}")
+                funcs.append(f"{pct} {sym[:60].rstrip()}")
         per = f"{1024 * int(kb) / faces:.0f}" if faces else "-"
         lines.append(f"| {name} | {st} | {float(wall):.1f} | {float(user) + float(sys_):.1f} | "
                      f"{int(kb) / 1024:.0f} | {per} | {'; '.join(funcs) or '-'} |")

@@ -421,6 +421,7 @@ impl Grid {
             let gap = self.contact_gap();
             let v = self.vertices();
             let body = &topo.face_body;
+            let nodes = self.node_bodies();
             self.triangles()
                 .par_iter()
                 .enumerate()
@@ -432,7 +433,6 @@ impl Grid {
                         .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
                         .fold(0.0, f64::max);
                     let own = body[f];
-                    let nodes = self.node_bodies();
                     self.bvh()
                         .closest_filtered_within_pruned(
                             m,

@@ -166,7 +166,8 @@ impl Grid {
                 p,
                 reach,
                 |t| !seen.contains(&body[t as usize]),
-                |n| nodes[n] == crate::spatial::MIXED_LABEL || !seen.contains(&nodes[n]),
+                // MIXED_LABEL is no body: mixed nodes are always searched.
+                |n| !seen.contains(&nodes[n]),
             ) else {
                 break;
             };

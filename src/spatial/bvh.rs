@@ -245,31 +245,7 @@ impl Bvh {
     /// every triangle below each node, or [`MIXED_LABEL`] where they differ.
     /// O(nodes).
     pub fn node_labels(&self, tri_label: &[u32]) -> Vec<u32> {
-        let mut out = vec![MIXED_LABEL; self.nodes.len()];
-        // Children come after their parent: a reverse sweep sees children first.
-        for i in (0..self.nodes.len()).rev() {
-            let n = &self.nodes[i];
-            out[i] = if n.is_leaf() {
-                let s = n.start as usize;
-                let mut labels = self.prim_triangle[s..s + n.count as usize]
-                    .iter()
-                    .map(|&t| tri_label[t as usize]);
-                let first = labels.next().unwrap_or(MIXED_LABEL);
-                if labels.all(|l| l == first) {
-                    first
-                } else {
-                    MIXED_LABEL
-                }
-            } else {
-                let (l, r) = (out[i + 1], out[n.start as usize]);
-                if l == r {
-                    l
-                } else {
-                    MIXED_LABEL
-                }
-            };
-        }
-        out
+        self.fold_subtrees(tri_label, |a, b| if a == b { a } else { MIXED_LABEL })
     }
 
     /// Branch and bound from the bound `bound2` (squared distance), seeded by
@@ -439,18 +415,28 @@ impl Bvh {
     /// For per-triangle values `tri_min`, the minimum over each node's subtree
     /// (used as the lower bound of branch-and-bound queries). O(nodes).
     pub fn node_minima(&self, tri_min: &[f64]) -> Vec<f64> {
-        let mut out = vec![f64::INFINITY; self.nodes.len()];
+        self.fold_subtrees(tri_min, f64::min)
+    }
+
+    /// Per node, `merge` folded over the values `per_tri` of the triangles
+    /// below it (leaves hold at least one). O(nodes).
+    fn fold_subtrees<T: Copy>(&self, per_tri: &[T], merge: impl Fn(T, T) -> T) -> Vec<T> {
+        let Some(&first) = per_tri.first() else {
+            return Vec::new();
+        };
+        let mut out = vec![first; self.nodes.len()];
         // Children come after their parent: a reverse sweep sees children first.
         for i in (0..self.nodes.len()).rev() {
             let n = &self.nodes[i];
             out[i] = if n.is_leaf() {
                 let s = n.start as usize;
-                self.prim_triangle[s..s + n.count as usize]
+                let mut values = self.prim_triangle[s..s + n.count as usize]
                     .iter()
-                    .map(|&t| tri_min[t as usize])
-                    .fold(f64::INFINITY, f64::min)
+                    .map(|&t| per_tri[t as usize]);
+                let v0 = values.next().unwrap_or(first);
+                values.fold(v0, &merge)
             } else {
-                out[i + 1].min(out[n.start as usize])
+                merge(out[i + 1], out[n.start as usize])
             };
         }
         out
