@@ -331,6 +331,12 @@ fn run(
         let collapses = ops::collapse_short(&mut mesh, &lim);
         let repaired = ops::repair_flat(&mut mesh, &lim, 0.02);
         let flips = ops::flip_valence(&mut mesh, &lim);
+        // Free the slots the collapses left before relaxing: the first
+        // iteration's splits of long input needles leave several times the
+        // final mesh in slots, and relaxation's per-slot temporaries would
+        // come on top. Compaction keeps the order of what lives and
+        // relaxation is per vertex, so the result is the same.
+        mesh.compact();
         let mut it = IterationReport {
             splits,
             collapses: collapses + repaired,
@@ -341,7 +347,6 @@ fn run(
             let relax = params.relax_steps > 0 || k > 0;
             it.cut_moves += smooth::relax_and_project(&mut mesh, &reference, relax, lim.cos_turn);
         }
-        mesh.compact();
         it.vertices = mesh.vertex_count();
         it.faces = mesh.face_count();
         it.seconds = t.elapsed().as_secs_f64();
@@ -367,6 +372,8 @@ fn run(
         .filter(|&e| mesh.edge_flags[e as usize] & crate::mesh::halfedge::E_FEATURE != 0)
         .map(|e| mesh.edge_vertices(e).map(|v| map[v as usize]))
         .collect();
+    // The working mesh is done: its memory is not the output grid's peak too.
+    drop((mesh, map, sizes));
     let grid = Grid::from_arrays(
         verts,
         tris,

@@ -68,6 +68,9 @@ pub fn split_long(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) 
             break;
         }
         long.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+        // The first sweeps on a tessellation of long needles split hundreds
+        // of thousands of edges: room for exactly this sweep, not a doubling.
+        mesh.reserve_splits(long.len());
         for (_, e) in long {
             let [a, b] = mesh.edge_vertices(e);
             let l = target(mesh, a, b) * 4.0 / 3.0;

@@ -124,6 +124,36 @@ impl HalfedgeMesh {
         v
     }
 
+    /// Makes room for `splits` more [`HalfedgeMesh::split`]s (each adds one
+    /// vertex, up to three edges and two faces) without growing any array
+    /// beyond that: a batch of splits whose count is known then costs its
+    /// own size, not the up to 2× of amortised doubling. O(current size)
+    /// when an array must move.
+    pub fn reserve_splits(&mut self, splits: usize) {
+        let (nv, ne, nf) = (splits, 3 * splits, 2 * splits);
+        self.positions.reserve_exact(nv);
+        self.vout.reserve_exact(nv);
+        self.vdel.reserve_exact(nv);
+        self.vertex_size.reserve_exact(nv);
+        self.vertex_flags.reserve_exact(nv);
+        self.vertex_origin.reserve_exact(nv);
+        self.vertex_hint.reserve_exact(nv);
+        for h in [
+            &mut self.to,
+            &mut self.next,
+            &mut self.prev,
+            &mut self.hface,
+        ] {
+            h.reserve_exact(2 * ne);
+        }
+        self.edel.reserve_exact(ne);
+        self.edge_flags.reserve_exact(ne);
+        self.edge_line.reserve_exact(ne);
+        self.fhe.reserve_exact(nf);
+        self.fdel.reserve_exact(nf);
+        self.face_patch.reserve_exact(nf);
+    }
+
     /// New edge from `a` to `b` with unlinked half-edges; returns the half-edge `a → b`.
     fn new_edge(&mut self, a: u32, b: u32) -> u32 {
         let h = self.to.len() as u32;
@@ -347,30 +377,38 @@ impl HalfedgeMesh {
     }
 
     /// Removes all tombstones, renumbering elements in their current order
-    /// (so the result is deterministic). Returns the old → new vertex map
-    /// ([`NONE`] for removed vertices). O(V + E + F).
+    /// (so the result is deterministic), in place, and gives the freed
+    /// capacity back. Returns the old → new vertex map ([`NONE`] for removed
+    /// vertices). O(V + E + F) time; beyond the mesh, only the three maps
+    /// (4 bytes per slot).
     pub fn compact(&mut self) -> Vec<u32> {
-        fn renumber(del: &[bool]) -> (Vec<u32>, usize) {
+        fn renumber(del: &[bool]) -> Vec<u32> {
             let mut map = vec![NONE; del.len()];
             let mut n = 0;
             for (i, &d) in del.iter().enumerate() {
                 if !d {
-                    map[i] = n as u32;
+                    map[i] = n;
                     n += 1;
                 }
             }
-            (map, n)
+            map
         }
-        fn keep<T: Copy>(v: &[T], del: &[bool]) -> Vec<T> {
-            v.iter()
-                .zip(del)
-                .filter(|(_, &d)| !d)
-                .map(|(x, _)| *x)
-                .collect()
+        /// Moves each kept element `i` (new index ≤ `i`) to the front
+        /// through `f`, in order, then drops the rest and the spare capacity.
+        fn squeeze<T: Copy>(v: &mut Vec<T>, gone: impl Fn(usize) -> bool, f: impl Fn(T) -> T) {
+            let mut n = 0;
+            for i in 0..v.len() {
+                if !gone(i) {
+                    v[n] = f(v[i]);
+                    n += 1;
+                }
+            }
+            v.truncate(n);
+            v.shrink_to_fit();
         }
-        let (vmap, _) = renumber(&self.vdel);
-        let (emap, _) = renumber(&self.edel);
-        let (fmap, _) = renumber(&self.fdel);
+        let vmap = renumber(&self.vdel);
+        let emap = renumber(&self.edel);
+        let fmap = renumber(&self.fdel);
         let hmap = |h: u32| {
             if h == NONE {
                 NONE
@@ -379,24 +417,25 @@ impl HalfedgeMesh {
             }
         };
         let fm = |f: u32| if f == NONE { NONE } else { fmap[f as usize] };
-        let hdel: Vec<bool> = (0..self.to.len()).map(|h| self.edel[h >> 1]).collect();
-        self.to = keep(&self.to, &hdel)
-            .into_iter()
-            .map(|v| vmap[v as usize])
-            .collect();
-        self.next = keep(&self.next, &hdel).into_iter().map(hmap).collect();
-        self.prev = keep(&self.prev, &hdel).into_iter().map(hmap).collect();
-        self.hface = keep(&self.hface, &hdel).into_iter().map(fm).collect();
-        self.vout = keep(&self.vout, &self.vdel).into_iter().map(hmap).collect();
-        self.fhe = keep(&self.fhe, &self.fdel).into_iter().map(hmap).collect();
-        self.positions = keep(&self.positions, &self.vdel);
-        self.vertex_size = keep(&self.vertex_size, &self.vdel);
-        self.vertex_flags = keep(&self.vertex_flags, &self.vdel);
-        self.vertex_origin = keep(&self.vertex_origin, &self.vdel);
-        self.vertex_hint = keep(&self.vertex_hint, &self.vdel);
-        self.edge_flags = keep(&self.edge_flags, &self.edel);
-        self.edge_line = keep(&self.edge_line, &self.edel);
-        self.face_patch = keep(&self.face_patch, &self.fdel);
+        let (vdel, edel, fdel) = (&self.vdel, &self.edel, &self.fdel);
+        let hgone = |h: usize| edel[h >> 1];
+        let vgone = |v: usize| vdel[v];
+        let egone = |e: usize| edel[e];
+        let fgone = |f: usize| fdel[f];
+        squeeze(&mut self.to, hgone, |v| vmap[v as usize]);
+        squeeze(&mut self.next, hgone, hmap);
+        squeeze(&mut self.prev, hgone, hmap);
+        squeeze(&mut self.hface, hgone, fm);
+        squeeze(&mut self.vout, vgone, hmap);
+        squeeze(&mut self.fhe, fgone, hmap);
+        squeeze(&mut self.positions, vgone, std::convert::identity);
+        squeeze(&mut self.vertex_size, vgone, std::convert::identity);
+        squeeze(&mut self.vertex_flags, vgone, std::convert::identity);
+        squeeze(&mut self.vertex_origin, vgone, std::convert::identity);
+        squeeze(&mut self.vertex_hint, vgone, std::convert::identity);
+        squeeze(&mut self.edge_flags, egone, std::convert::identity);
+        squeeze(&mut self.edge_line, egone, std::convert::identity);
+        squeeze(&mut self.face_patch, fgone, std::convert::identity);
         self.vdel = vec![false; self.positions.len()];
         self.edel = vec![false; self.edge_flags.len()];
         self.fdel = vec![false; self.face_patch.len()];

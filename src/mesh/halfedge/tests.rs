@@ -111,14 +111,42 @@ fn split_collapse_flip_compact() {
         }
     }
     assert!(flips > 10);
+    let (bv, bt, _) = m.to_arrays(true);
+    let live: Vec<[f64; 3]> = m.vertices().map(|v| m.positions[v as usize]).collect();
     let map = m.compact();
     m.check().unwrap();
+    // In place, in order: the same mesh, the same numbering, no spare room.
+    let (av, at, _) = m.to_arrays(true);
+    assert_eq!((av, at), (bv, bt));
+    assert_eq!(m.positions, live);
+    assert_eq!(m.positions.capacity(), m.positions.len());
     assert_eq!(map.iter().filter(|&&x| x != NONE).count(), v0);
     assert_eq!(m.n_vertices(), v0);
     let (v, t, _) = m.to_arrays(true);
     let topo = Topology::build(v.len(), &t);
     assert_eq!(topo.boundary_edge_count(), 16);
     assert_eq!(topo.non_manifold_edge_count(), 0);
+}
+
+#[test]
+fn reserved_splits_fit_without_growing() {
+    let g = plate(4);
+    let (mut m, _) = HalfedgeMesh::from_grid(&g, None);
+    let edges: Vec<u32> = m.edges().collect();
+    m.reserve_splits(edges.len());
+    let cap = m.positions.capacity();
+    assert!(cap >= m.n_vertices() + edges.len());
+    for e in edges {
+        let [a, b] = m.edge_vertices(e);
+        let mid = crate::geometry::lerp(m.positions[a as usize], m.positions[b as usize], 0.5);
+        m.split(e, mid);
+    }
+    m.check().unwrap();
+    assert_eq!(
+        m.positions.capacity(),
+        cap,
+        "no array grew past the reservation"
+    );
 }
 
 #[test]
