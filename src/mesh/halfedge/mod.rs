@@ -379,20 +379,12 @@ impl HalfedgeMesh {
     /// Removes all tombstones, renumbering elements in their current order
     /// (so the result is deterministic), in place, and gives the freed
     /// capacity back. Returns the old → new vertex map ([`NONE`] for removed
-    /// vertices). O(V + E + F) time; beyond the mesh, only the three maps
-    /// (4 bytes per slot).
+    /// vertices). O(V + E + F) time. Beyond the mesh it needs a rank index
+    /// (about 0.2 bytes per slot) while it moves, and the returned map only
+    /// once the arrays have shrunk: compaction right after the first
+    /// remeshing iteration's splits, the largest the mesh ever is, adds
+    /// nothing to that peak.
     pub fn compact(&mut self) -> Vec<u32> {
-        fn renumber(del: &[bool]) -> Vec<u32> {
-            let mut map = vec![NONE; del.len()];
-            let mut n = 0;
-            for (i, &d) in del.iter().enumerate() {
-                if !d {
-                    map[i] = n;
-                    n += 1;
-                }
-            }
-            map
-        }
         /// Moves each kept element `i` (new index ≤ `i`) to the front
         /// through `f`, in order, then drops the rest and the spare capacity.
         fn squeeze<T: Copy>(v: &mut Vec<T>, gone: impl Fn(usize) -> bool, f: impl Fn(T) -> T) {
@@ -406,23 +398,31 @@ impl HalfedgeMesh {
             v.truncate(n);
             v.shrink_to_fit();
         }
-        let vmap = renumber(&self.vdel);
-        let emap = renumber(&self.edel);
-        let fmap = renumber(&self.fdel);
+        let (vrank, erank, frank) = (
+            Rank::new(&self.vdel),
+            Rank::new(&self.edel),
+            Rank::new(&self.fdel),
+        );
         let hmap = |h: u32| {
             if h == NONE {
                 NONE
             } else {
-                2 * emap[(h >> 1) as usize] + (h & 1)
+                2 * erank.get((h >> 1) as usize) + (h & 1)
             }
         };
-        let fm = |f: u32| if f == NONE { NONE } else { fmap[f as usize] };
+        let fm = |f: u32| {
+            if f == NONE {
+                NONE
+            } else {
+                frank.get(f as usize)
+            }
+        };
         let (vdel, edel, fdel) = (&self.vdel, &self.edel, &self.fdel);
         let hgone = |h: usize| edel[h >> 1];
         let vgone = |v: usize| vdel[v];
         let egone = |e: usize| edel[e];
         let fgone = |f: usize| fdel[f];
-        squeeze(&mut self.to, hgone, |v| vmap[v as usize]);
+        squeeze(&mut self.to, hgone, |v| vrank.get(v as usize));
         squeeze(&mut self.next, hgone, hmap);
         squeeze(&mut self.prev, hgone, hmap);
         squeeze(&mut self.hface, hgone, fm);
@@ -436,6 +436,9 @@ impl HalfedgeMesh {
         squeeze(&mut self.edge_flags, egone, std::convert::identity);
         squeeze(&mut self.edge_line, egone, std::convert::identity);
         squeeze(&mut self.face_patch, fgone, std::convert::identity);
+        let vmap = (0..self.vdel.len())
+            .map(|v| if self.vdel[v] { NONE } else { vrank.get(v) })
+            .collect();
         self.vdel = vec![false; self.positions.len()];
         self.edel = vec![false; self.edge_flags.len()];
         self.fdel = vec![false; self.face_patch.len()];
@@ -573,6 +576,43 @@ impl HalfedgeMesh {
             }
         }
         Ok(())
+    }
+}
+
+/// Rank index over a deletion mask: the new index of a kept slot is the
+/// number of kept slots before it, read in O(1) from one bit per slot and a
+/// running count per 64 slots (about 0.19 bytes per slot instead of a
+/// 4-byte map).
+struct Rank {
+    /// Bit `i % 64` of word `i / 64`: slot `i` is kept.
+    kept: Vec<u64>,
+    /// Kept slots before each word.
+    before: Vec<u32>,
+}
+
+impl Rank {
+    /// The index of `del` (true: removed). O(n).
+    fn new(del: &[bool]) -> Rank {
+        let mut kept = Vec::with_capacity(del.len().div_ceil(64));
+        let mut before = Vec::with_capacity(kept.capacity());
+        let mut count = 0u32;
+        for chunk in del.chunks(64) {
+            let word = chunk
+                .iter()
+                .enumerate()
+                .fold(0u64, |w, (i, &d)| if d { w } else { w | 1 << i });
+            before.push(count);
+            count += word.count_ones();
+            kept.push(word);
+        }
+        Rank { kept, before }
+    }
+
+    /// Kept slots before slot `i`. O(1).
+    #[inline(always)]
+    fn get(&self, i: usize) -> u32 {
+        let (w, b) = (i / 64, i % 64);
+        self.before[w] + (self.kept[w] & ((1u64 << b) - 1)).count_ones()
     }
 }
 

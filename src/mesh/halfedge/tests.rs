@@ -129,6 +129,19 @@ fn split_collapse_flip_compact() {
 }
 
 #[test]
+fn rank_counts_the_kept_slots_before() {
+    for n in [0usize, 1, 63, 64, 65, 200] {
+        let del: Vec<bool> = (0..n).map(|i| (i * 7 + i / 5) % 3 == 0).collect();
+        let r = super::Rank::new(&del);
+        let mut kept = 0;
+        for (i, &d) in del.iter().enumerate() {
+            assert_eq!(r.get(i), kept, "slot {i} of {n}");
+            kept += u32::from(!d);
+        }
+    }
+}
+
+#[test]
 fn reserved_splits_fit_without_growing() {
     let g = plate(4);
     let (mut m, _) = HalfedgeMesh::from_grid(&g, None);
