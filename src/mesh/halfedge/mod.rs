@@ -381,9 +381,9 @@ impl HalfedgeMesh {
     /// capacity back. Returns the old → new vertex map ([`NONE`] for removed
     /// vertices). O(V + E + F) time. Beyond the mesh it needs a rank index
     /// (about 0.2 bytes per slot) while it moves, and the returned map only
-    /// once the arrays have shrunk: compaction right after the first
-    /// remeshing iteration's splits, the largest the mesh ever is, adds
-    /// nothing to that peak.
+    /// once the arrays have shrunk, so compacting the remesher's first
+    /// iteration, whose splits leave the most slots the mesh ever has, adds
+    /// little to that peak.
     pub fn compact(&mut self) -> Vec<u32> {
         /// Moves each kept element `i` (new index ≤ `i`) to the front
         /// through `f`, in order, then drops the rest and the spare capacity.
