@@ -1,13 +1,17 @@
 //! LBO-ABGS on synthetic shapes: after every iteration no flipped or
 //! degenerate face, Euler characteristic, bodies, corners and feature lines
 //! kept; a sharp size front is not smeared (banding); the same bits with 1
-//! and 2 threads; cancelling from the callback leaves a valid grid; the
-//! per-edge scores agree with their definition.
+//! and 2 threads, with either selection; the batched selection estimates
+//! less for a grid as good as the global one's; cancelling from the
+//! callback leaves a valid grid; the per-edge scores agree with their
+//! definition.
 
 mod common;
 
 use abgs::geometry::{cross, dot, norm, sub};
-use abgs::simplify::{edge_scores, simplify, IterationRecord, SimplifyParams, StopReason};
+use abgs::simplify::{
+    edge_scores, simplify, IterationRecord, Selection, SimplifyParams, StopReason,
+};
 use abgs::Grid;
 use common::shapes::{icosphere, Soup};
 use common::{euler, with_sizes};
@@ -211,16 +215,22 @@ fn same_bits_with_one_and_two_threads() {
     let dense = with_sizes(&icosphere(1.0, 4), |p| {
         0.1 + 0.05 * (3.0 * p[0]).sin().abs()
     });
-    let run = |threads: usize| {
+    let run = |threads: usize, selection: Selection| {
+        let params = SimplifyParams {
+            selection,
+            ..Default::default()
+        };
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| simplify(&dense, &SimplifyParams::default(), None).unwrap())
+            .install(|| simplify(&dense, &params, None).unwrap())
     };
-    let (a, b) = (run(1), run(2));
-    assert_eq!(bits(&a.grid), bits(&b.grid));
-    assert_eq!(a.report.iterations.len(), b.report.iterations.len());
+    for selection in [Selection::Batched, Selection::Global] {
+        let (a, b) = (run(1, selection), run(2, selection));
+        assert_eq!(bits(&a.grid), bits(&b.grid), "{selection:?}");
+        assert_eq!(a.report.iterations.len(), b.report.iterations.len());
+    }
     let sa = edge_scores(&dense, &SimplifyParams::default()).unwrap();
     let sb = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
@@ -230,6 +240,65 @@ fn same_bits_with_one_and_two_threads() {
     assert_eq!(
         sa.iter().map(|s| s.y.to_bits()).collect::<Vec<_>>(),
         sb.iter().map(|s| s.y.to_bits()).collect::<Vec<_>>()
+    );
+}
+
+/// The batched selection (the default) spends its estimates on edges that
+/// can still be chosen: far fewer estimates than the global selection's,
+/// for a valid grid of about as many faces and as faithful sizes.
+#[test]
+fn batched_selection_estimates_less_for_an_equal_grid() {
+    let dense = with_sizes(&icosphere(1.0, 5), |p| {
+        0.05 + 0.04 * (2.0 * p[0]).sin().abs()
+    });
+    let run = |selection| {
+        let params = SimplifyParams {
+            selection,
+            ..Default::default()
+        };
+        simplify(&dense, &params, None).unwrap()
+    };
+    let (batched, global) = (run(Selection::Batched), run(Selection::Global));
+    let estimated = |s: &abgs::simplify::Simplified, first: bool| {
+        let it = &s.report.iterations;
+        if first {
+            it[0].estimated
+        } else {
+            it.iter().map(|r| r.estimated).sum()
+        }
+    };
+    // The pool is 3,072 edges in 6 batches: the first batch is estimated
+    // whole, the later ones only where no collapse was claimed yet.
+    assert!(
+        estimated(&batched, true) * 2 < estimated(&global, true),
+        "first iteration: {} vs {}",
+        estimated(&batched, true),
+        estimated(&global, true)
+    );
+    assert!(estimated(&batched, false) < estimated(&global, false));
+    assert_valid("batched", &dense, &batched.grid, &[]);
+    let (nb, ng) = (
+        batched.grid.triangles().len() as f64,
+        global.grid.triangles().len() as f64,
+    );
+    assert!((nb / ng - 1.0).abs() < 0.15, "faces {nb} vs {ng}");
+    // Sizes on the sphere agree with the dense grid's as well as the
+    // global selection's do (within the same T_size budget).
+    let worst = |g: &Grid| {
+        let mut w: f64 = 1.0;
+        for i in 0..2000 {
+            let (t, z) = (i as f64 * 2.399_963, 1.0 - (2.0 * i as f64 + 1.0) / 2000.0);
+            let r = (1.0 - z * z).sqrt();
+            let p = [r * t.cos(), r * t.sin(), z];
+            let (a, b) = (dense.query_size(p).unwrap(), g.query_size(p).unwrap());
+            w = w.max((a / b).max(b / a));
+        }
+        w
+    };
+    let (wb, wg) = (worst(&batched.grid), worst(&global.grid));
+    assert!(
+        wb <= 1.3 && wb <= wg + 0.05,
+        "worst size ratio {wb} vs {wg}"
     );
 }
 

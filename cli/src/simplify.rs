@@ -25,6 +25,16 @@ pub enum Method {
     Qem,
 }
 
+/// How LBO-ABGS picks an iteration's collapses (`--selection`).
+#[derive(Clone, Copy, Debug, clap::ValueEnum, PartialEq, Eq)]
+pub enum Selection {
+    /// Batch by batch of the pool in LBO order, estimating only edges whose
+    /// rings are still free (the default; far fewer estimates).
+    Batched,
+    /// The whole pool estimated, then the lowest scores (DESIGN §3.5 as the paper has it).
+    Global,
+}
+
 /// The LBO-ABGS thresholds shared by `abgs simplify` and `abgs run` (fields of
 /// [`SimplifyParams`]).
 #[derive(clap::Args, Debug, Clone)]
@@ -35,6 +45,9 @@ pub struct LboArgs {
     /// Largest size ratio a collapse may cause (T_size).
     #[arg(long, default_value_t = SimplifyParams::default().t_size)]
     pub t_size: f64,
+    /// How each iteration picks its collapses from the candidate pool.
+    #[arg(long, value_enum, default_value_t = Selection::Batched)]
+    pub selection: Selection,
     /// Fixed distance rule Δd ≤ τ_d·h_loc (the paper's is 0.05) in place of
     /// the derived Δd ≤ ½·ln(T_size)·h / ln β (default: derived).
     #[arg(long)]
@@ -76,6 +89,10 @@ impl LboArgs {
     pub fn params(&self, feature_angle_deg: f64, beta: f64, repair: bool) -> SimplifyParams {
         SimplifyParams {
             fraction: self.fraction,
+            selection: match self.selection {
+                Selection::Batched => abgs::simplify::Selection::Batched,
+                Selection::Global => abgs::simplify::Selection::Global,
+            },
             t_size: self.t_size,
             t_contact: self.t_contact,
             tau_d: self.tau_d,
@@ -129,6 +146,7 @@ pub fn params_json(p: &SimplifyParams) -> Value {
         "method": match p.method { LibMethod::Lbo => "lbo", LibMethod::Gcn => "gcn" },
         "t_score": p.t_score, "verify": p.verify,
         "fraction": p.fraction, "pool_factor": p.pool_factor, "t_size": p.t_size,
+        "selection": match p.selection { abgs::simplify::Selection::Batched => "batched", abgs::simplify::Selection::Global => "global" },
         "t_contact": p.t_contact, "tau_d": p.tau_d, "beta": p.beta,
         "clearance_fraction": if p.clearance_fraction.is_finite() { json!(p.clearance_fraction) } else { Value::Null },
         "max_distance": p.max_distance, "max_iterations": p.max_iterations,

@@ -272,6 +272,7 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
         verify: p.verify == 1,
         fraction: p.fraction,
         pool_factor: p.pool_factor,
+        selection: simplify::Selection::default(),
         t_size: p.t_size,
         t_contact: p.t_contact,
         tau_d: (p.tau_d > 0.0).then_some(p.tau_d),

@@ -6,10 +6,14 @@
 //! 1. ranks the edges by the LBO of the size field (smoothest first),
 //! 2. takes the best-ranked `2·n·|E|` edges not already known to be
 //!    non-collapsible as candidates,
-//! 3. estimates each candidate exactly as its real collapse would go
+//! 3. estimates candidates exactly as their real collapses would go
 //!    ([`estimate`]), in parallel,
-//! 4. selects the lowest scores `y < 0.5` whose closed 1-rings are pairwise
-//!    disjoint, up to `n·|E|`,
+//! 4. selects scores `y < 0.5` whose closed 1-rings are pairwise disjoint,
+//!    up to `n·|E|`: by default batch by batch of the pool in LBO order,
+//!    estimating only edges whose rings are still free and taking each
+//!    batch's lowest scores ([`Selection::Batched`]); or over the whole
+//!    estimated pool, lowest scores first ([`Selection::Global`], DESIGN
+//!    §3.5 as the paper has it),
 //! 5. collapses them and repairs locally (relaxation and flips, each checked
 //!    like a collapse),
 //! 6. re-projects the sizes of moved vertices from the target,
@@ -65,6 +69,25 @@ pub enum Method {
     Gcn,
 }
 
+/// How LBO-ABGS picks an iteration's collapses from its candidate pool
+/// (see [`scorer::Accurate`] for each one's cost).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Selection {
+    /// The pool in LBO order, in batches of [`scorer::BATCH`] edges: an
+    /// edge whose closed 1-ring meets a collapse already chosen this
+    /// iteration is skipped without being estimated, the others are
+    /// estimated in parallel, and the batch's collapsible ones are taken by
+    /// lowest score while their rings stay disjoint. Estimates only what can
+    /// still be chosen.
+    #[default]
+    Batched,
+    /// DESIGN §3.5 step 4 as the paper has it: the whole pool estimated,
+    /// then the lowest scores taken while their rings stay disjoint. About
+    /// 20 estimates per collapse on a fine grid, most of them of edges
+    /// whose neighbourhood changes before they could be chosen.
+    Global,
+}
+
 /// Parameters of LBO-ABGS and GCN-ABGS (defaults from DESIGN §3.5–3.6).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SimplifyParams {
@@ -80,6 +103,9 @@ pub struct SimplifyParams {
     pub fraction: f64,
     /// Candidate pool size as a multiple of `n·|E|` (default 2).
     pub pool_factor: f64,
+    /// LBO-ABGS: how an iteration's collapses are picked from the pool
+    /// (default [`Selection::Batched`]).
+    pub selection: Selection,
     /// Largest size ratio a collapse may cause (`T_size`, default 1.2).
     pub t_size: f64,
     /// Largest size ratio a collapse may cause where bodies touch
@@ -127,6 +153,7 @@ impl Default for SimplifyParams {
             verify: false,
             fraction: 0.10,
             pool_factor: 2.0,
+            selection: Selection::Batched,
             t_size: 1.2,
             t_contact: DEFAULT_T_CONTACT,
             tau_d: None,
@@ -339,6 +366,9 @@ struct TargetParts {
     lines: FeatureLines,
     seg_sizes: Vec<[f64; 2]>,
     envelope: envelope::Envelope,
+    /// Per target triangle: the reach of its patch ring (see
+    /// [`crate::spatial::RingMesh`]).
+    reach: Vec<f64>,
 }
 
 impl TargetParts {
@@ -352,6 +382,7 @@ impl TargetParts {
             seg_sizes: &self.seg_sizes,
             envelope: &self.envelope,
             contact: grid.contact_faces(),
+            reach: &self.reach,
         }
     }
 }
@@ -379,6 +410,7 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
         .collect();
     let lim = params.limits();
     let envelope = envelope::Envelope::compute(grid, sizes, &features, lim.size_term, lim.kappa);
+    let reach = Target::ring_mesh(grid, &features.face_patch).reaches();
     Ok((
         mesh,
         TargetParts {
@@ -386,6 +418,7 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
             lines,
             seg_sizes,
             envelope,
+            reach,
         },
     ))
 }

@@ -22,6 +22,7 @@ use super::estimate::Limits;
 use crate::geometry::lerp;
 use crate::mesh::feature_lines::FeatureLines;
 use crate::mesh::Grid;
+use crate::spatial::RingMesh;
 
 /// Where a point lands on the target.
 #[derive(Debug, Clone, Copy)]
@@ -57,9 +58,26 @@ pub struct Target<'a> {
     /// Per target triangle: another body's face may lie within the contact
     /// gap of it (empty for a single body; see [`Grid::contact_faces`]).
     pub contact: &'a [bool],
+    /// Per target triangle: the reach of its patch ring, for searches that
+    /// start from a known triangle ([`RingMesh::reaches`]).
+    pub reach: &'a [f64],
 }
 
-impl Target<'_> {
+impl<'a> Target<'a> {
+    /// The target grid's triangles, vertex stars and patches, as the
+    /// certified ring search reads them.
+    pub fn ring_mesh(grid: &'a Grid, face_patch: &'a [u32]) -> RingMesh<'a> {
+        let topo = grid.topology();
+        RingMesh {
+            vertices: grid.vertices(),
+            triangles: grid.triangles(),
+            star_offsets: &topo.vertex_face_offsets,
+            star_faces: &topo.vertex_faces,
+            labels: face_patch,
+            bvh: grid.bvh(),
+        }
+    }
+
     /// How far the simplified grid may lie from the target at target triangle
     /// `tri` (`NONE`: unknown, the size term with no gradient and no
     /// clearance), the target size being `h` there and `h_loc` at the edge
@@ -74,13 +92,21 @@ impl Target<'_> {
     }
 
     /// Closest point of `p` on patch `patch` (anywhere on the target when the
-    /// patch is empty), starting from triangle `hint`. O(log F) typically.
+    /// patch is empty), starting from triangle `hint`: in the hint's ring
+    /// when its certificate holds, else by the BVH (the same answer either
+    /// way, see [`RingMesh`]). O(1) near the hint, O(log F) typically.
     pub fn on_patch(&self, p: [f64; 3], patch: u32, hint: u32) -> Option<Hit> {
         let bvh = self.grid.bvh();
-        let hint = (hint != u32::MAX).then_some(hint);
-        let hit = bvh
-            .closest_filtered(p, hint, |t| self.face_patch[t as usize] == patch)
-            .or_else(|| bvh.closest(p, None))?;
+        let near =
+            Target::ring_mesh(self.grid, self.face_patch).closest_near(self.reach, p, patch, hint);
+        let hit = match near {
+            Ok(hit) => hit,
+            Err(seed) => {
+                let hint = (seed != u32::MAX).then_some(seed);
+                bvh.closest_filtered(p, hint, |t| self.face_patch[t as usize] == patch)
+                    .or_else(|| bvh.closest(p, None))?
+            }
+        };
         let t = self.grid.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;
         let size = b[0] * self.sizes[t[0] as usize]
