@@ -293,7 +293,7 @@ mod tests {
     #[test]
     fn a_start_outside_the_label_or_range_is_refused() {
         let s = wavy(6);
-        let (t, labels, bvh, mesh) = (&s.t, &s.labels, &s.bvh, s.mesh());
+        let (t, labels, mesh) = (&s.t, &s.labels, s.mesh());
         let reach = mesh.reaches();
         let p = [0.9, 0.9, 0.0];
         let other = (0..t.len()).find(|&u| labels[u] != 2).unwrap() as u32;
