@@ -46,6 +46,7 @@ int main(void) {
     CHECK(p.beta == 1.2 && p.clearance_fraction == 0.25);
     CHECK(p.max_iterations == 200 && p.repair == 1 && p.progress == NULL);
     CHECK(p.t_score == 0.5 && p.verify == 0);
+    CHECK(p.selection == ABGS_SELECTION_BATCHED);
     CHECK_STATUS(abgs_simplify_params_default(NULL), ABGS_ERR_NULL);
     /* A struct whose struct_size was not set is refused, not overrun. */
     abgs_simplify_params z = {0};
@@ -179,6 +180,23 @@ int main(void) {
     bad.method = 7; /* no such method: checked, never taken as an enum */
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
     CHECK(strstr(abgs_last_error_message(), "method = 7") != NULL);
+    bad = p;
+    bad.selection = 2; /* no such selection */
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(abgs_last_error_message(), "selection = 2") != NULL);
+    /* The paper's global selection: the same kind of grid. */
+    {
+        abgs_simplify_params g = p;
+        g.selection = ABGS_SELECTION_GLOBAL;
+        abgs_grid *gout = NULL;
+        abgs_simplify_report gr = {.struct_size = sizeof gr};
+        CHECK_STATUS(abgs_simplify(dense, &g, &gout, &gr), ABGS_OK);
+        CHECK(gout != NULL && gr.faces_out < NT / 2 && gr.stop == ABGS_STOP_CONVERGED);
+        double q = 0.0, mid[3] = {0.5, 0.5, 0.0};
+        CHECK_STATUS(abgs_query_size(gout, mid, &q), ABGS_OK);
+        CHECK(fabs(q - (0.02 + 0.2 * 0.5)) < 0.2 * (0.02 + 0.2 * 0.5));
+        CHECK_STATUS(abgs_grid_free(gout), ABGS_OK);
+    }
     bad = p;
     bad.struct_size = 0;
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);

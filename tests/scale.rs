@@ -84,8 +84,12 @@ fn decimal_scales_stay_within_the_rounding_spread() {
     for (name, base) in shapes() {
         let faces = |s: f64| pipeline(&scaled(&base, s)).1.triangles().len() as f64;
         let f1 = faces(1.0);
-        // The spread one rounding of the input causes, at scale ~1.
-        let spread = [1.0 + 1e-12, 1.0 - 1e-12, 3.0]
+        // The spread one rounding of the input causes, at scale ~1. On a
+        // field this uniform the LBO order of the edges is rounding noise,
+        // and the batched selection follows it: the sphere's 234 faces
+        // become 226-252 under these factors, so it takes several of them to
+        // see the spread.
+        let spread = [1.0 + 1e-12, 1.0 - 1e-12, 1.0 + 1e-9, 3.0, 7.0, 0.1]
             .map(|s| (faces(s) / f1 - 1.0).abs())
             .into_iter()
             .fold(0.0, f64::max);

@@ -100,6 +100,9 @@ def test_parameter_errors() -> None:
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(method="qem"))
     e = raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(method=7))
     assert "method" in e.message
+    raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(selection="lazy"))
+    e = raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(selection=2))
+    assert "selection" in e.message
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(max_iterations=-1))
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(max_iterations=2.5))
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.remesh(iterations=0))

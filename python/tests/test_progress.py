@@ -98,3 +98,15 @@ def test_busy_inside_callback(dense: abgs.Grid) -> None:
     assert len(errors) == 2 and all(e.status == abgs.errors.ERR_BUSY for e in errors)
     assert not dense.closed
     np.testing.assert_array_equal(dense.sizes, before)
+
+
+def test_global_selection(dense: abgs.Grid, coarse: abgs.Grid) -> None:
+    """The paper's global selection estimates more for the same kind of grid
+    (the default is the batched one)."""
+    g = dense.simplify(selection="global")
+    est = [sum(r.estimated for r in x.iterations()) for x in (g, coarse)]
+    assert est[0] > est[1]
+    assert g.simplify_report is not None and coarse.simplify_report is not None
+    faces = (g.simplify_report.faces_out, coarse.simplify_report.faces_out)
+    assert abs(faces[0] / faces[1] - 1.0) < 0.2, faces
+    assert g.simplify_report.stop == abgs.STOP_CONVERGED

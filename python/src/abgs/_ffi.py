@@ -39,6 +39,10 @@ NO_HINT = 0xFFFFFFFF
 METHOD_LBO = 0
 #: ``method``: GCN-ABGS, the learned simplifier.
 METHOD_GCN = 1
+#: ``selection``: the whole pool estimated, then the lowest scores (the paper's).
+SELECTION_GLOBAL = 0
+#: ``selection``: the pool in batches, estimating only edges still free (default).
+SELECTION_BATCHED = 1
 #: ``stop``: nothing could be selected any more.
 STOP_CONVERGED = 0
 #: ``stop``: ``max_iterations`` reached.
@@ -330,6 +334,7 @@ class SimplifyParams(_Struct):
         ("t_score", c_double),
         ("verify", c_uint32),
         ("t_contact", c_double),
+        ("selection", c_uint32),
     ]
 
 

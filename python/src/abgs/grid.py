@@ -29,6 +29,8 @@ from ._ffi import (
     METHOD_LBO,
     NO_HINT,
     PROGRESS_FN,
+    SELECTION_BATCHED,
+    SELECTION_GLOBAL,
     SOURCE_POINT,
     SOURCE_SEGMENT,
     SOURCE_TRIANGLE,
@@ -525,6 +527,7 @@ class Grid:
         method: str | int = "lbo",
         fraction: float | None = None,
         pool_factor: float | None = None,
+        selection: str | int | None = None,
         t_size: float | None = None,
         t_contact: float | None = None,
         tau_d: float | None = None,
@@ -549,7 +552,9 @@ class Grid:
 
         ``method``: ``"lbo"`` (LBO-ABGS, default) or ``"gcn"`` (GCN-ABGS, the
         embedded model; ``t_score`` 0.5 and ``verify`` apply). Defaults:
-        fraction 0.10, pool_factor 2, t_contact 1.2 (where bodies touch; lower makes touching bodies' own fields agree, at a cost in faces),
+        fraction 0.10, pool_factor 2, selection ``"batched"`` (``"global"``:
+        the whole pool estimated, then the lowest scores, the paper's
+        selection; about 3x slower), t_contact 1.2 (where bodies touch; lower makes touching bodies' own fields agree, at a cost in faces),
         tau_d 0 (derived envelope),
         max_distance 0 (none), max_iterations 200, feature and corner angle
         30°, normal turn 60°, max angle 150°, repair on, beta 1.2,
@@ -565,6 +570,8 @@ class Grid:
         (parameters, an unknown method), ``BusyError``.
         """
         method = _method(method)
+        if selection is not None:
+            selection = _selection(selection)
         values = dict(locals())
         values.pop("progress")
         p = _defaults(SimplifyParams, lib.abgs_simplify_params_default, values)
@@ -625,6 +632,17 @@ def _method(method: str | int) -> int:
             raise error(ERR_INVALID_ARGUMENT, f"method: expected 'lbo' or 'gcn', got {method!r}")
         return _METHODS[method.lower()]
     return method
+
+
+def _selection(selection: str | int) -> int:
+    """The ABI's number of a selection: ``"batched"``, ``"global"`` or an
+    int (passed on for the library to check)."""
+    if isinstance(selection, str):
+        names = {"batched": SELECTION_BATCHED, "global": SELECTION_GLOBAL}
+        if selection.lower() not in names:
+            raise error(ERR_INVALID_ARGUMENT, f"selection: expected 'batched' or 'global', got {selection!r}")
+        return names[selection.lower()]
+    return selection
 
 
 def _trampoline(progress: Progress, raised: list[BaseException]) -> Callable[[Any, Any], int]:
