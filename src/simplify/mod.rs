@@ -366,8 +366,8 @@ struct TargetParts {
     lines: FeatureLines,
     seg_sizes: Vec<[f64; 2]>,
     envelope: envelope::Envelope,
-    /// Per target triangle: the reach of its patch ring (see
-    /// [`crate::spatial::RingMesh`]).
+    /// Per target vertex: its reach (see
+    /// [`crate::spatial::StarMesh`]).
     reach: Vec<f64>,
 }
 
@@ -410,7 +410,7 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
         .collect();
     let lim = params.limits();
     let envelope = envelope::Envelope::compute(grid, sizes, &features, lim.size_term, lim.kappa);
-    let reach = Target::ring_mesh(grid, &features.face_patch).reaches();
+    let reach = Target::star_mesh(grid, &features.face_patch).reaches();
     Ok((
         mesh,
         TargetParts {

@@ -22,7 +22,7 @@ use super::estimate::Limits;
 use crate::geometry::lerp;
 use crate::mesh::feature_lines::FeatureLines;
 use crate::mesh::Grid;
-use crate::spatial::RingMesh;
+use crate::spatial::StarMesh;
 
 /// Where a point lands on the target.
 #[derive(Debug, Clone, Copy)]
@@ -58,17 +58,18 @@ pub struct Target<'a> {
     /// Per target triangle: another body's face may lie within the contact
     /// gap of it (empty for a single body; see [`Grid::contact_faces`]).
     pub contact: &'a [bool],
-    /// Per target triangle: the reach of its patch ring, for searches that
-    /// start from a known triangle ([`RingMesh::reaches`]).
+    /// Per target vertex: its reach (the distance to the nearest triangle
+    /// not containing it), for searches that start from a known triangle
+    /// ([`StarMesh::reaches`]).
     pub reach: &'a [f64],
 }
 
 impl<'a> Target<'a> {
     /// The target grid's triangles, vertex stars and patches, as the
-    /// certified ring search reads them.
-    pub fn ring_mesh(grid: &'a Grid, face_patch: &'a [u32]) -> RingMesh<'a> {
+    /// certified star search reads them.
+    pub fn star_mesh(grid: &'a Grid, face_patch: &'a [u32]) -> StarMesh<'a> {
         let topo = grid.topology();
-        RingMesh {
+        StarMesh {
             vertices: grid.vertices(),
             triangles: grid.triangles(),
             star_offsets: &topo.vertex_face_offsets,
@@ -92,13 +93,14 @@ impl<'a> Target<'a> {
     }
 
     /// Closest point of `p` on patch `patch` (anywhere on the target when the
-    /// patch is empty), starting from triangle `hint`: in the hint's ring
-    /// when its certificate holds, else by the BVH (the same answer either
-    /// way, see [`RingMesh`]). O(1) near the hint, O(log F) typically.
+    /// patch is empty), starting from triangle `hint`: in the star of the
+    /// hint's corner nearest `p` when its certificate holds, else by the BVH
+    /// (the same answer either way, see [`StarMesh`]). O(1) near the hint,
+    /// O(log F) typically.
     pub fn on_patch(&self, p: [f64; 3], patch: u32, hint: u32) -> Option<Hit> {
         let bvh = self.grid.bvh();
         let near =
-            Target::ring_mesh(self.grid, self.face_patch).closest_near(self.reach, p, patch, hint);
+            Target::star_mesh(self.grid, self.face_patch).closest_near(self.reach, p, patch, hint);
         let hit = match near {
             Ok(hit) => hit,
             Err(seed) => {

@@ -1,12 +1,12 @@
 //! Spatial indexing: a bounding-volume hierarchy over triangles, and the
-//! certified ring search that answers near a known triangle without it.
+//! certified star search that answers near a known triangle without it.
 
 mod bvh;
 mod layout;
 mod ray;
-mod ring;
+mod star;
 
 pub use bvh::{Bvh, ClosestHit, Node, MAX_DEPTH, MIXED_LABEL};
 pub use layout::BvhLayout;
 pub use ray::ray_triangle;
-pub use ring::RingMesh;
+pub use star::StarMesh;

@@ -25,7 +25,7 @@
 //!
 //! The search starts at the corner of the start triangle nearest to `p`; when
 //! the certificate fails it moves to the corner of `B` nearest to `p` and
-//! tries again (a walk towards `p`, at most [`MAX_STEPS`] stars), then gives
+//! tries again (a walk towards `p`, at most `MAX_STEPS` (4) stars), then gives
 //! up, and the caller asks the BVH. On a well-shaped grid `r_v` is about the
 //! height of the star's triangles and `d_v` at most about 0.6 of an edge for
 //! a point on the surface, so it fails where `p` lies more than a fraction of
@@ -36,7 +36,7 @@
 //!
 //! Building the reaches: one filtered BVH search per vertex, O(V log F),
 //! parallel; 8 bytes per vertex. A certified query evaluates one to
-//! [`MAX_STEPS`] stars of about 6 triangles (vertex stars from
+//! `MAX_STEPS` (4) stars of about 6 triangles (vertex stars from
 //! [`crate::mesh::Topology`]), against a descent of about 30 nodes and 9
 //! triangles spread over the whole tree; the star's triangles sit close
 //! together in the BVH's leaf order, so its reads stay in cache. Ties the
@@ -55,7 +55,7 @@ const MAX_STEPS: usize = 4;
 /// around each vertex (compressed rows), a label per triangle and the BVH
 /// over the same triangles (for its corners and rounding scale).
 #[derive(Clone, Copy)]
-pub struct RingMesh<'a> {
+pub struct StarMesh<'a> {
     /// Vertex positions.
     pub vertices: &'a [[f64; 3]],
     /// Triangles (vertex indices).
@@ -70,7 +70,7 @@ pub struct RingMesh<'a> {
     pub bvh: &'a Bvh,
 }
 
-impl RingMesh<'_> {
+impl StarMesh<'_> {
     /// Rounding slack of distances near `p` (as the BVH's: `1e-12` of the
     /// largest coordinate magnitude).
     #[inline]
@@ -122,7 +122,7 @@ impl RingMesh<'_> {
 
     /// The exact closest point of `p` among the triangles labelled `label`,
     /// searched from triangle `start` (which must carry `label`), or `None`
-    /// when no certificate was found within [`MAX_STEPS`] stars (then ask
+    /// when no certificate was found within `MAX_STEPS` (4) stars (then ask
     /// the BVH). When `Some`, it is [`Bvh::closest_filtered`]'s answer bit
     /// for bit. O(star size · steps).
     pub fn closest_near(
@@ -204,8 +204,8 @@ mod tests {
             }
         }
 
-        fn mesh(&self) -> RingMesh<'_> {
-            RingMesh {
+        fn mesh(&self) -> StarMesh<'_> {
+            StarMesh {
                 vertices: &self.v,
                 triangles: &self.t,
                 star_offsets: &self.topo.vertex_face_offsets,
@@ -284,9 +284,9 @@ mod tests {
                 assert_eq!(got.closest.dist2.to_bits(), want.closest.dist2.to_bits());
             }
         }
-        // Most near points are certified (87 % here: the right-angled
-        // triangles' centroid balls are loose, and a label's border cuts
-        // rings short).
+        // Most near points are certified (a star at a label's border holds
+        // few triangles of the label, and the walk gives up after a few
+        // stars).
         assert!(certified * 10 > asked * 8, "{certified} of {asked}");
     }
 
