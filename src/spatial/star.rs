@@ -121,10 +121,11 @@ impl StarMesh<'_> {
     }
 
     /// The exact closest point of `p` among the triangles labelled `label`,
-    /// searched from triangle `start` (which must carry `label`), or `None`
-    /// when no certificate was found within `MAX_STEPS` (4) stars (then ask
-    /// the BVH). When `Some`, it is [`Bvh::closest_filtered`]'s answer bit
-    /// for bit. O(star size · steps).
+    /// searched from triangle `start` (which must carry `label`): `Ok` with
+    /// [`Bvh::closest_filtered`]'s answer bit for bit, or `Err` with the
+    /// nearest triangle of the label seen (`start` when none was) when no
+    /// certificate was found within `MAX_STEPS` (4) stars: then ask the BVH,
+    /// with that triangle as its hint. O(star size · steps).
     pub fn closest_near(
         &self,
         reach: &[f64],
