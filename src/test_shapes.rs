@@ -1,4 +1,12 @@
-//! Synthetic shapes shared by the unit tests.
+//! Synthetic shapes and pseudo-random numbers shared by the unit tests.
+
+/// Deterministic pseudo-random numbers in [0, 1) (a 64-bit LCG).
+pub(crate) fn rng(seed: &mut u64) -> f64 {
+    *seed = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    (*seed >> 11) as f64 / (1u64 << 53) as f64
+}
 
 /// The unit square subdivided `n × n` (two triangles per cell, counter-
 /// clockwise seen from +z), lifted to `z(x, y)`: `(n+1)²` vertices row by

@@ -1,13 +1,6 @@
 use super::field::{Source, SourceField};
 use crate::geometry::closest_point_triangle;
-
-/// Deterministic pseudo-random numbers in [0, 1).
-fn rng(seed: &mut u64) -> f64 {
-    *seed = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    (*seed >> 11) as f64 / (1u64 << 53) as f64
-}
+use crate::test_shapes::rng;
 
 #[test]
 fn source_field_equals_brute_force() {

@@ -148,13 +148,43 @@ pub struct Accurate {
 }
 
 /// Edges of the pool handled per batch by [`Selection::Batched`]: enough
-/// parallel work for any thread count (a batch's estimates take
-/// milliseconds), few against a pool of thousands, so that little is
+/// parallel work for any thread count (a batch's estimates take tens of
+/// milliseconds on the big shared models), few against a pool of thousands, so that little is
 /// estimated before the claims of the batches ahead of it. A constant, so
 /// the choice does not depend on the thread count.
 pub const BATCH: usize = 512;
 
+/// Lowest score first, ties by edge index.
+fn by_score(a: &(u32, Estimate), b: &(u32, Estimate)) -> std::cmp::Ordering {
+    a.1.y.total_cmp(&b.1.y).then(a.0.cmp(&b.0))
+}
+
 impl Accurate {
+    /// Estimates `edges` in parallel and keeps the estimates, stamped with
+    /// this iteration.
+    fn estimate_afresh(&mut self, view: &View, edges: &[u32]) {
+        let estimates: Vec<Estimate> = edges
+            .par_iter()
+            .map(|&e| estimate::estimate(view.mesh, view.target, e, view.lim, 0.5))
+            .collect();
+        for (&e, est) in edges.iter().zip(estimates) {
+            self.cache[e as usize] = Some((view.iteration, est));
+        }
+    }
+
+    /// The collapsible ones of `edges` by their kept estimates, lowest score
+    /// first (see [`by_score`]).
+    fn collapsible(&self, edges: impl Iterator<Item = u32>) -> Vec<(u32, Estimate)> {
+        let mut out: Vec<(u32, Estimate)> = edges
+            .filter_map(|e| {
+                let (_, est) = self.cache[e as usize]?;
+                est.collapsible().then_some((e, est))
+            })
+            .collect();
+        out.sort_by(by_score);
+        out
+    }
+
     /// [`Selection::Batched`] over `pool` (see [`Accurate`]). The edges
     /// returned have pairwise disjoint closed 1-rings, lowest score first.
     /// O(Σ ring sizes + estimates).
@@ -179,23 +209,9 @@ impl Accurate {
                     }
                 }
             }
-            let estimates: Vec<Estimate> = fresh
-                .par_iter()
-                .map(|&e| estimate::estimate(mesh, view.target, e, view.lim, 0.5))
-                .collect();
+            self.estimate_afresh(view, &fresh);
             estimated += fresh.len();
-            for (&e, est) in fresh.iter().zip(estimates) {
-                self.cache[e as usize] = Some((view.iteration, est));
-            }
-            let mut good: Vec<(u32, Estimate)> = open
-                .iter()
-                .filter_map(|&e| {
-                    let (_, est) = self.cache[e as usize]?;
-                    est.collapsible().then_some((e, est))
-                })
-                .collect();
-            good.sort_by(|a, b| a.1.y.total_cmp(&b.1.y).then(a.0.cmp(&b.0)));
-            for (e, est) in good {
+            for (e, est) in self.collapsible(open.iter().copied()) {
                 if free(e, &mut ring, &claimed) {
                     for &v in &ring {
                         claimed[v as usize] = true;
@@ -204,7 +220,7 @@ impl Accurate {
                 }
             }
         }
-        ranked.sort_by(|a, b| a.1.y.total_cmp(&b.1.y).then(a.0.cmp(&b.0)));
+        ranked.sort_by(by_score);
         Ranking {
             ranked,
             candidates: pool.len(),
@@ -247,21 +263,8 @@ impl EdgeScorer for Accurate {
             return Ok(self.rank_batched(view, &pool, pool_size));
         }
         let fresh: Vec<u32> = pool.iter().filter(|x| x.1).map(|x| x.0).collect();
-        let estimates: Vec<Estimate> = fresh
-            .par_iter()
-            .map(|&e| estimate::estimate(mesh, view.target, e, view.lim, 0.5))
-            .collect();
-        for (&e, est) in fresh.iter().zip(estimates) {
-            self.cache[e as usize] = Some((view.iteration, est));
-        }
-        let mut ranked: Vec<(u32, Estimate)> = pool
-            .iter()
-            .filter_map(|&(e, _)| {
-                let (_, est) = self.cache[e as usize]?;
-                est.collapsible().then_some((e, est))
-            })
-            .collect();
-        ranked.sort_by(|a, b| a.1.y.total_cmp(&b.1.y).then(a.0.cmp(&b.0)));
+        self.estimate_afresh(view, &fresh);
+        let ranked = self.collapsible(pool.iter().map(|x| x.0));
         Ok(Ranking {
             ranked,
             candidates: pool.len(),

@@ -181,7 +181,7 @@ impl StarMesh<'_> {
 mod tests {
     use super::*;
     use crate::mesh::Topology;
-    use crate::test_shapes::unit_square;
+    use crate::test_shapes::{rng, unit_square};
 
     /// A test surface with its labels, topology and BVH.
     struct Surface {
@@ -230,13 +230,6 @@ mod tests {
         Surface::new(v, t, labels)
     }
 
-    fn lcg(seed: &mut u64) -> f64 {
-        *seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (*seed >> 11) as f64 / (1u64 << 53) as f64
-    }
-
     #[test]
     fn certified_answers_are_the_bvh_answers_bit_for_bit() {
         let s = wavy(24);
@@ -250,9 +243,9 @@ mod tests {
         for i in 0..6000 {
             // Points on and near the surface, some exactly on vertices and
             // edges (ties between triangles), some far off.
-            let tri = (lcg(&mut seed) * t.len() as f64) as usize;
+            let tri = (rng(&mut seed) * t.len() as f64) as usize;
             let c = bvh.prim_corners[bvh.triangle_prim[tri] as usize];
-            let (a, b) = (lcg(&mut seed), lcg(&mut seed));
+            let (a, b) = (rng(&mut seed), rng(&mut seed));
             let (a, b) = match i % 4 {
                 0 => (1.0, 0.0),
                 1 => (0.5, 0.5),
@@ -261,7 +254,7 @@ mod tests {
             let off = match i % 5 {
                 0 => 0.0,
                 1 => 0.3,
-                _ => 0.01 * (lcg(&mut seed) - 0.5),
+                _ => 0.01 * (rng(&mut seed) - 0.5),
             };
             let p = [0, 1, 2].map(|k| {
                 c[0][k] * (1.0 - a - b) + c[1][k] * a + c[2][k] * b + if k == 2 { off } else { 0.0 }
