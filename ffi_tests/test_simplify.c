@@ -44,9 +44,9 @@ int main(void) {
     CHECK(p.method == ABGS_METHOD_LBO && p.fraction == 0.10 && p.pool_factor == 2.0);
     CHECK(p.t_size == 1.2 && p.tau_d == 0.0 && p.max_distance == 0.0);
     CHECK(p.beta == 1.2 && p.clearance_fraction == 0.25);
-    CHECK(p.max_iterations == 200 && p.repair == 1 && p.progress == NULL);
+    CHECK(p.max_iterations == 1000 && p.repair == 1 && p.progress == NULL);
     CHECK(p.t_score == 0.5 && p.verify == 0);
-    CHECK(p.selection == ABGS_SELECTION_BATCHED);
+    CHECK(p.selection == ABGS_SELECTION_BATCHED && p.fit_sizes == 1);
     CHECK_STATUS(abgs_simplify_params_default(NULL), ABGS_ERR_NULL);
     /* A struct whose struct_size was not set is refused, not overrun. */
     abgs_simplify_params z = {0};
@@ -180,6 +180,42 @@ int main(void) {
     bad.method = 7; /* no such method: checked, never taken as an enum */
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
     CHECK(strstr(abgs_last_error_message(), "method = 7") != NULL);
+    bad = p;
+    bad.fit_sizes = 2; /* a flag: 0 or 1 */
+    CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);
+    CHECK(strstr(abgs_last_error_message(), "fit_sizes = 2") != NULL);
+    /* Without the size fit each vertex keeps the ramp's value at its
+       position; with it (the default) a linear field is fitted exactly: the
+       same faces and, to the solver's tolerance, the same sizes. */
+    {
+        abgs_simplify_params f = p;
+        f.fit_sizes = 0;
+        abgs_grid *fout = NULL;
+        abgs_simplify_report fr = {.struct_size = sizeof fr};
+        CHECK_STATUS(abgs_simplify(dense, &f, &fout, &fr), ABGS_OK);
+        CHECK(fr.faces_out == nt);
+        size_t fv = 0;
+        CHECK_STATUS(abgs_grid_vertex_count(fout, &fv), ABGS_OK);
+        double *fx = malloc(3 * fv * sizeof *fx), *fh = malloc(fv * sizeof *fh);
+        double *dh = malloc(nv * sizeof *dh), *dx = malloc(3 * nv * sizeof *dx);
+        CHECK_STATUS(abgs_grid_copy_vertices(fout, fx, 3 * fv), ABGS_OK);
+        CHECK_STATUS(abgs_grid_copy_sizes(fout, fh, fv), ABGS_OK);
+        CHECK_STATUS(abgs_grid_copy_vertices(out, dx, 3 * nv), ABGS_OK);
+        CHECK_STATUS(abgs_grid_copy_sizes(out, dh, nv), ABGS_OK);
+        for (size_t i = 0; i < fv; i++) {
+            double ramp = 0.02 + 0.2 * fx[3 * i];
+            CHECK(fabs(fh[i] - ramp) <= 1e-12 * ramp);
+        }
+        for (size_t i = 0; i < nv; i++) {
+            double ramp = 0.02 + 0.2 * dx[3 * i];
+            CHECK(fabs(dh[i] - ramp) <= 1e-6 * ramp);
+        }
+        free(fx);
+        free(fh);
+        free(dh);
+        free(dx);
+        CHECK_STATUS(abgs_grid_free(fout), ABGS_OK);
+    }
     bad = p;
     bad.selection = 2; /* no such selection */
     CHECK_STATUS(abgs_simplify(dense, &bad, &none, NULL), ABGS_ERR_INVALID_ARGUMENT);

@@ -415,7 +415,7 @@ typedef struct {
   double tau_d;
   // Largest distance to the dense grid in model units; 0 = no limit (default 0).
   double max_distance;
-  // Most iterations, >= 1 (default 200).
+  // Most iterations, >= 1 (default 1000; a cap, not the stop rule).
   uint32_t max_iterations;
   // Dihedral angle (degrees) above which an edge is a kept feature (default 30).
   double feature_angle_deg;
@@ -453,6 +453,14 @@ typedef struct {
   // ABGS_SELECTION_BATCHED (the default) or ABGS_SELECTION_GLOBAL; other
   // values are ABGS_ERR_INVALID_ARGUMENT.
   uint32_t selection;
+  // 1 (the default): after the last iteration the vertex sizes are fitted
+  // to the dense field (least squares, weighted by element density, each
+  // within t_size of its value before), so the simplified field errs
+  // both ways instead of lying above the dense one where elements are
+  // small; 0: each vertex keeps the dense field's size at its position
+  // (the paper's rule; the only one before this field existed, hence 0).
+  // Other values are ABGS_ERR_INVALID_ARGUMENT.
+  uint32_t fit_sizes;
 } abgs_simplify_params;
 
 // What `abgs_simplify` did.

@@ -4,7 +4,8 @@
 //! and 2 threads, with either selection; the batched selection estimates
 //! less for a grid as good as the global one's; cancelling from the
 //! callback leaves a valid grid; the per-edge scores agree with their
-//! definition.
+//! definition; the size fit removes the interpolation's bias on a graded
+//! field.
 
 mod common;
 
@@ -200,6 +201,67 @@ fn sharp_size_front_is_not_smeared() {
         let h = out.query_size([0.49, y, 0.0]).unwrap();
         assert!(h <= 0.02 * 1.2, "size {h} just left of the front");
     }
+}
+
+/// A graded cone of sizes around a small spot (what a fillet or a gap makes:
+/// `h = h₀ + ln β · distance`) is convex along the surface, so sizes taken
+/// at the simplified vertices lie above it between them, and most where
+/// elements are small. The size fit (the default) removes that bias: the
+/// element-weighted mean log ratio of simplified to dense sizes moves to
+/// about 0, the estimated element count toward the dense grid's, and the
+/// grid itself (vertices, triangles) is the same; no size moves by more
+/// than `T_size`.
+#[test]
+fn size_fit_removes_the_interpolation_bias_of_a_graded_field() {
+    let mut soup = Soup::default();
+    soup.quad([0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 80, 80);
+    let slope = 1.2f64.ln();
+    let cone = move |p: [f64; 3]| 0.01 + slope * norm(sub(p, [0.5, 0.5, 0.0]));
+    let dense = with_sizes(&soup.grid(), cone);
+    let run = |fit_sizes| {
+        let params = SimplifyParams {
+            fit_sizes,
+            ..Default::default()
+        };
+        simplify(&dense, &params, None).unwrap()
+    };
+    let (fit, plain) = (run(true), run(false));
+    assert_eq!(fit.grid.vertices(), plain.grid.vertices());
+    assert_eq!(fit.grid.triangles(), plain.grid.triangles());
+    assert!(fit.report.fit.samples > 0 && fit.report.fit.steps > 0);
+    assert_eq!(plain.report.fit.samples, 0);
+    for (a, b) in fit
+        .grid
+        .sizes()
+        .unwrap()
+        .iter()
+        .zip(plain.grid.sizes().unwrap())
+    {
+        assert!((a / b).max(b / a) <= 1.2 * (1.0 + 1e-12), "{a} vs {b}");
+    }
+    // Plate vertices stand for equal areas: weight 1/h² is the element density.
+    let bias = |g: &Grid| {
+        let (mut sum, mut weight) = (0.0, 0.0);
+        for (p, &h) in dense.vertices().iter().zip(dense.sizes().unwrap()) {
+            let w = 1.0 / (h * h);
+            sum += w * (g.query_size(*p).unwrap() / h).ln();
+            weight += w;
+        }
+        sum / weight
+    };
+    let (bf, bp) = (bias(&fit.grid), bias(&plain.grid));
+    assert!(
+        bp > 0.01,
+        "sizes at the vertices lie above a convex field: {bp}"
+    );
+    assert!(bf.abs() < 0.5 * bp, "fitted bias {bf} against {bp}");
+    let count = |g: &Grid| abgs::metrics::estimated_element_count(&dense, Some(g)).unwrap();
+    let n0 = count(&dense);
+    let (cf, cp) = (count(&fit.grid) / n0 - 1.0, count(&plain.grid) / n0 - 1.0);
+    assert!(
+        cf.abs() < cp.abs(),
+        "element count change {cf} against {cp}"
+    );
 }
 
 fn bits(g: &Grid) -> (Vec<[u64; 3]>, Vec<[u32; 3]>, Vec<u64>) {

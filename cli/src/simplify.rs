@@ -72,6 +72,11 @@ pub struct LboArgs {
     /// Largest turn of a face normal per collapse, move or flip, degrees.
     #[arg(long, default_value_t = SimplifyParams::default().max_normal_turn_deg)]
     pub max_normal_turn: f64,
+    /// Keep the dense field's size at each simplified vertex instead of
+    /// fitting the vertex sizes to the dense field at the end (the paper's
+    /// rule; the fit removes the interpolation's bias toward larger sizes).
+    #[arg(long)]
+    pub no_fit_sizes: bool,
     /// GCN-ABGS: edges whose predicted score is at or above this are not tried (T_score).
     #[arg(long, default_value_t = SimplifyParams::default().t_score)]
     pub t_score: f64,
@@ -110,6 +115,7 @@ impl LboArgs {
             repair,
             t_score: self.t_score,
             verify: self.verify,
+            fit_sizes: !self.no_fit_sizes,
             ..Default::default()
         }
     }
@@ -152,7 +158,7 @@ pub fn params_json(p: &SimplifyParams) -> Value {
         "max_distance": p.max_distance, "max_iterations": p.max_iterations,
         "feature_angle_deg": p.feature_angle_deg, "corner_angle_deg": p.corner_angle_deg,
         "max_normal_turn_deg": p.max_normal_turn_deg, "max_angle_deg": p.max_angle_deg,
-        "repair": p.repair,
+        "repair": p.repair, "fit_sizes": p.fit_sizes,
     })
 }
 
@@ -186,6 +192,10 @@ pub fn report_json(s: &Simplified) -> Value {
             StopReason::Cancelled => "cancelled",
         },
         "seconds": r.seconds,
+        "fit": {
+            "samples": r.fit.samples, "steps": r.fit.steps, "clamped": r.fit.clamped,
+            "seconds": r.fit_seconds,
+        },
         "binding": {
             "free": r.binding.free, "topology": r.binding.topology, "feature": r.binding.feature,
             "degenerate": r.binding.degenerate, "normal_turn": r.binding.normal_turn,

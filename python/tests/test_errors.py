@@ -103,6 +103,8 @@ def test_parameter_errors() -> None:
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(selection="lazy"))
     e = raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(selection=2))
     assert "selection" in e.message
+    e = raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(fit_sizes=2))
+    assert "fit_sizes" in e.message
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(max_iterations=-1))
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.simplify(max_iterations=2.5))
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.remesh(iterations=0))

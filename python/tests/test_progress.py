@@ -110,3 +110,15 @@ def test_global_selection(dense: abgs.Grid, coarse: abgs.Grid) -> None:
     faces = (g.simplify_report.faces_out, coarse.simplify_report.faces_out)
     assert abs(faces[0] / faces[1] - 1.0) < 0.2, faces
     assert g.simplify_report.stop == abgs.STOP_CONVERGED
+
+
+def test_fit_sizes_off(dense: abgs.Grid, coarse: abgs.Grid) -> None:
+    """Without the size fit the same grid comes out with the sizes the
+    collapses left: different from the fitted ones, but never by more than
+    t_size (1.2)."""
+    g = dense.simplify(fit_sizes=False)
+    np.testing.assert_array_equal(g.vertices, coarse.vertices)
+    np.testing.assert_array_equal(g.triangles, coarse.triangles)
+    assert not np.array_equal(g.sizes, coarse.sizes)
+    ratio = g.sizes / coarse.sizes
+    assert np.all(np.maximum(ratio, 1.0 / ratio) <= 1.2 * (1.0 + 1e-12))

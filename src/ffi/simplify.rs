@@ -97,7 +97,7 @@ pub struct abgs_simplify_params {
     pub tau_d: f64,
     /// Largest distance to the dense grid in model units; 0 = no limit (default 0).
     pub max_distance: f64,
-    /// Most iterations, >= 1 (default 200).
+    /// Most iterations, >= 1 (default 1000; a cap, not the stop rule).
     pub max_iterations: u32,
     /// Dihedral angle (degrees) above which an edge is a kept feature (default 30).
     pub feature_angle_deg: f64,
@@ -135,6 +135,14 @@ pub struct abgs_simplify_params {
     /// ABGS_SELECTION_BATCHED (the default) or ABGS_SELECTION_GLOBAL; other
     /// values are ABGS_ERR_INVALID_ARGUMENT.
     pub selection: u32,
+    /// 1 (the default): after the last iteration the vertex sizes are fitted
+    /// to the dense field (least squares, weighted by element density, each
+    /// within t_size of its value before), so the simplified field errs
+    /// both ways instead of lying above the dense one where elements are
+    /// small; 0: each vertex keeps the dense field's size at its position
+    /// (the paper's rule; the only one before this field existed, hence 0).
+    /// Other values are ABGS_ERR_INVALID_ARGUMENT.
+    pub fit_sizes: u32,
 }
 
 /// What `abgs_simplify` did.
@@ -196,6 +204,7 @@ fn default_params() -> abgs_simplify_params {
         verify: d.verify as u32,
         t_contact: d.t_contact,
         selection: ABGS_SELECTION_BATCHED,
+        fit_sizes: d.fit_sizes as u32,
     }
 }
 
@@ -279,6 +288,12 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
             format!("verify = {} must be 0 or 1", p.verify),
         );
     }
+    if p.fit_sizes > 1 {
+        return err(
+            abgs_status::ABGS_ERR_INVALID_ARGUMENT,
+            format!("fit_sizes = {} must be 0 or 1", p.fit_sizes),
+        );
+    }
     if p.max_iterations == 0 {
         return err(
             abgs_status::ABGS_ERR_INVALID_ARGUMENT,
@@ -316,6 +331,7 @@ fn to_params(p: &abgs_simplify_params) -> FfiResult<SimplifyParams> {
         max_normal_turn_deg: p.max_normal_turn_deg,
         max_angle_deg: p.max_angle_deg,
         repair: p.repair != 0,
+        fit_sizes: p.fit_sizes == 1,
     };
     params.check()?;
     Ok(params)

@@ -19,7 +19,9 @@
 //! 6. re-projects the sizes of moved vertices from the target,
 //!
 //! and the loop stops when nothing is selected, after `max_iterations`, or
-//! when the progress callback asks to.
+//! when the progress callback asks to. Then the vertex sizes are fitted to
+//! the target by element-weighted least squares ([`fit`], on by default:
+//! sizes taken at the vertices lie above a convex field between them).
 //!
 //! An estimate depends only on the closed 1-rings of the edge's two ends, so
 //! it is kept between iterations until a vertex there changes: an edge found
@@ -32,6 +34,7 @@
 
 pub mod envelope;
 pub mod estimate;
+pub mod fit;
 mod repair;
 pub mod scorer;
 pub mod select;
@@ -128,7 +131,10 @@ pub struct SimplifyParams {
     pub clearance_fraction: f64,
     /// Largest distance to the target in model units (`None`: no limit).
     pub max_distance: Option<f64>,
-    /// Most iterations (default 200).
+    /// Most iterations (default 1000): a cap against a loop that does not
+    /// end, not the stop rule (nothing selected). At 200 it cut 5 of the 15
+    /// shared models below 250k faces short while each iteration still
+    /// collapsed a few edges; all 17 converge within 245.
     pub max_iterations: usize,
     /// Dihedral angle (degrees) above which an edge is a feature (default 30).
     pub feature_angle_deg: f64,
@@ -143,6 +149,11 @@ pub struct SimplifyParams {
     pub max_angle_deg: f64,
     /// Local repair after each batch (relaxation and flips; default true).
     pub repair: bool,
+    /// Fit the vertex sizes to the target after the last iteration
+    /// (default true; see [`fit`]): the simplified field then errs both
+    /// ways instead of lying above the target where elements are small.
+    /// `false` keeps the target's size at each vertex (the paper's rule).
+    pub fit_sizes: bool,
 }
 
 impl Default for SimplifyParams {
@@ -160,12 +171,13 @@ impl Default for SimplifyParams {
             beta: 1.2,
             clearance_fraction: envelope::DEFAULT_CLEARANCE_FRACTION,
             max_distance: None,
-            max_iterations: 200,
+            max_iterations: 1000,
             feature_angle_deg: 30.0,
             corner_angle_deg: 30.0,
             max_normal_turn_deg: 60.0,
             max_angle_deg: 150.0,
             repair: true,
+            fit_sizes: true,
         }
     }
 }
@@ -328,6 +340,10 @@ pub struct SimplifyReport {
     /// estimated once more at the end, as the loop does: the first term
     /// found over its bound).
     pub binding: BindingCounts,
+    /// The size fit's work (zeros when [`SimplifyParams::fit_sizes`] is off).
+    pub fit: fit::FitReport,
+    /// Seconds in the size fit.
+    pub fit_seconds: f64,
     /// Seconds in all.
     pub seconds: f64,
 }
@@ -619,6 +635,11 @@ pub(crate) fn run_loop(
             iteration: last,
             last: true,
         })?;
+    }
+    if params.fit_sizes {
+        let t = Instant::now();
+        report.fit = fit::fit_sizes(&mut mesh, &target, lim.t_size);
+        report.fit_seconds = t.elapsed().as_secs_f64();
     }
     report.binding = census(&mesh, &target, &lim);
     let out = finish(&mesh)?;

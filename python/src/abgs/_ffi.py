@@ -335,6 +335,7 @@ class SimplifyParams(_Struct):
         ("verify", c_uint32),
         ("t_contact", c_double),
         ("selection", c_uint32),
+        ("fit_sizes", c_uint32),
     ]
 
 

@@ -542,6 +542,7 @@ class Grid:
         clearance_fraction: float | None = None,
         t_score: float | None = None,
         verify: bool | None = None,
+        fit_sizes: bool | None = None,
         progress: Progress | None = None,
     ) -> Grid:
         """The simplified grid: edge collapses keeping the interpolated size
@@ -556,9 +557,12 @@ class Grid:
         the whole pool estimated, then the lowest scores, the paper's
         selection; about 3x slower), t_contact 1.2 (where bodies touch; lower makes touching bodies' own fields agree, at a cost in faces),
         tau_d 0 (derived envelope),
-        max_distance 0 (none), max_iterations 200, feature and corner angle
+        max_distance 0 (none), max_iterations 1000, feature and corner angle
         30°, normal turn 60°, max angle 150°, repair on, beta 1.2,
-        clearance_fraction 0.25.
+        clearance_fraction 0.25, fit_sizes on (the vertex sizes fitted to
+        this grid's field at the end, by element-weighted least squares;
+        off: each vertex keeps this grid's size at its position, the
+        paper's rule, whose sizes lie above the field where it is small).
 
         ``progress(record)`` is called after each iteration that collapsed
         something, on this thread, with an ``IterationRecord``; a truthy return
