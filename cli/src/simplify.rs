@@ -193,7 +193,7 @@ pub fn report_json(s: &Simplified) -> Value {
         },
         "seconds": r.seconds,
         "fit": {
-            "samples": r.fit.samples, "steps": r.fit.steps, "clamped": r.fit.clamped,
+            "samples": r.fit.samples, "steps": r.fit.steps, "clamped": r.fit.clamped, "frozen": r.fit.frozen,
             "seconds": r.fit_seconds,
         },
         "binding": {

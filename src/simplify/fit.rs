@@ -29,6 +29,11 @@
 //! face, solved by Jacobi-preconditioned conjugate gradients to a relative
 //! residual of [`TOLERANCE`].
 //!
+//! **Contacts.** A vertex of a face with a sample lying on two bodies keeps
+//! its size (its unknown is held at 1 in a projected CG): each body is
+//! fitted on its own, and moving one side of an interface would break the
+//! agreement the collapses kept there ([`super::target`]).
+//!
 //! **Bounds.** A fitted size stays within `[h⁰/T_size, h⁰·T_size]` of the
 //! size it replaces (the collapses' own tolerance), so a vertex that few
 //! samples see cannot drift. The fit trades the largest errors for the
@@ -79,6 +84,9 @@ pub struct FitReport {
     pub steps: usize,
     /// Vertices whose fitted size met a bound (`h⁰/T_size` or `h⁰·T_size`).
     pub clamped: usize,
+    /// Vertices kept as they were because a face of theirs has a sample on
+    /// two bodies.
+    pub frozen: usize,
 }
 
 /// Lattice divisions of a face with corners `p` and sizes `h`: the
@@ -96,8 +104,9 @@ fn divisions(p: &[[f64; 3]; 3], h: &[f64; 3]) -> usize {
 }
 
 /// Samples face `f` and returns its block (zero where its samples cannot
-/// reach the target or a size is not positive).
-fn face_block(mesh: &HalfedgeMesh, target: &Target, f: u32) -> (Block, usize) {
+/// reach the target or a size is not positive), the samples taken and
+/// whether one lies on two bodies.
+fn face_block(mesh: &HalfedgeMesh, target: &Target, f: u32) -> (Block, usize, bool) {
     let corners = mesh.face_vertices(f);
     let p = corners.map(|v| mesh.positions[v as usize]);
     let h0 = corners.map(|v| mesh.vertex_size[v as usize]);
@@ -106,7 +115,7 @@ fn face_block(mesh: &HalfedgeMesh, target: &Target, f: u32) -> (Block, usize) {
         ..Block::default()
     };
     if h0.iter().any(|&h| !(h > 0.0 && h.is_finite())) {
-        return (block, 0);
+        return (block, 0, false);
     }
     let n = divisions(&p, &h0);
     let count = (n - 1) * (n - 2) / 2;
@@ -115,6 +124,7 @@ fn face_block(mesh: &HalfedgeMesh, target: &Target, f: u32) -> (Block, usize) {
     let mut hint = mesh.vertex_hint[corners[0] as usize];
     let inv = 1.0 / n as f64;
     let mut taken = 0;
+    let mut contact = false;
     for i in 1..n {
         for j in 1..n - i {
             let k = n - i - j;
@@ -127,6 +137,7 @@ fn face_block(mesh: &HalfedgeMesh, target: &Target, f: u32) -> (Block, usize) {
                 continue;
             };
             hint = hit.index;
+            contact |= hit.contact;
             let ht = hit.size;
             if !(ht > 0.0 && ht.is_finite()) {
                 continue;
@@ -142,7 +153,7 @@ fn face_block(mesh: &HalfedgeMesh, target: &Target, f: u32) -> (Block, usize) {
             taken += 1;
         }
     }
-    (block, taken)
+    (block, taken, contact)
 }
 
 /// `y = A·x` for the assembled blocks plus the diagonal `ridge`.
@@ -169,7 +180,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// solver step, sequential.
 pub fn fit_sizes(mesh: &mut HalfedgeMesh, target: &Target, t_size: f64) -> FitReport {
     let faces: Vec<u32> = mesh.faces().collect();
-    let sampled: Vec<(Block, usize)> = faces
+    let sampled: Vec<(Block, usize, bool)> = faces
         .par_iter()
         .map(|&f| face_block(mesh, target, f))
         .collect();
@@ -178,6 +189,18 @@ pub fn fit_sizes(mesh: &mut HalfedgeMesh, target: &Target, t_size: f64) -> FitRe
         samples: sampled.iter().map(|s| s.1).sum(),
         ..FitReport::default()
     };
+    // A vertex of a face with a sample on two bodies keeps its size: each
+    // body's fit would move its side of the interface on its own, and the
+    // two must agree there (see `super::target`).
+    let mut frozen = vec![false; n];
+    for (blk, _, contact) in &sampled {
+        if *contact {
+            for &v in &blk.corners {
+                frozen[v as usize] = true;
+            }
+        }
+    }
+    report.frozen = frozen.iter().filter(|&&f| f).count();
     let blocks: Vec<Block> = sampled.into_iter().map(|s| s.0).collect();
     let mut diag = vec![0.0; n];
     let mut rhs = vec![0.0; n];
@@ -205,11 +228,21 @@ pub fn fit_sizes(mesh: &mut HalfedgeMesh, target: &Target, t_size: f64) -> FitRe
     let mut x = vec![1.0; n];
     let mut ax = vec![0.0; n];
     apply(&blocks, &ridge, &x, &mut ax);
+    let mask = |v: &mut Vec<f64>| {
+        for (x, &f) in v.iter_mut().zip(&frozen) {
+            if f {
+                *x = 0.0;
+            }
+        }
+    };
     let mut r: Vec<f64> = rhs.iter().zip(&ax).map(|(b, a)| b - a).collect();
+    mask(&mut r);
     let mut z: Vec<f64> = r.iter().zip(&precond).map(|(r, m)| r * m).collect();
     let mut d = z.clone();
     let mut rz = dot(&r, &z);
-    let stop = TOLERANCE * dot(&rhs, &rhs).sqrt();
+    let mut free_rhs = rhs.clone();
+    mask(&mut free_rhs);
+    let stop = TOLERANCE * dot(&free_rhs, &free_rhs).sqrt();
     let mut ad = vec![0.0; n];
     while report.steps < MAX_STEPS && dot(&r, &r).sqrt() > stop {
         apply(&blocks, &ridge, &d, &mut ad);
@@ -222,6 +255,7 @@ pub fn fit_sizes(mesh: &mut HalfedgeMesh, target: &Target, t_size: f64) -> FitRe
             x[i] += alpha * d[i];
             r[i] -= alpha * ad[i];
         }
+        mask(&mut r);
         for i in 0..n {
             z[i] = r[i] * precond[i];
         }
