@@ -44,7 +44,7 @@
 //! **Cost.** Sampling is one projection per lattice point, like a single
 //! estimate of every face: about `S·F` projections (S ≈ 10–120), parallel
 //! over faces; the solve is O(F) per CG step, sequential, for well under a
-//! hundred steps (20–26 on the shared models). Measured at 0.3–1.7 % of a
+//! hundred steps (19–26 on the shared models). Measured at 0.3–1.7 % of a
 //! simplification.
 //!
 //! **Ties.** Deterministic: faces are sampled in parallel but their blocks
