@@ -51,8 +51,9 @@
 //! are summed in face order and CG runs sequentially, so the bits do not
 //! depend on the thread count.
 
+use super::estimate::divisions;
 use super::target::Target;
-use crate::geometry::{add, norm, scale, sub, triangle_area};
+use crate::geometry::{add, scale, triangle_area};
 use crate::mesh::halfedge::{HalfedgeMesh, NONE};
 use rayon::prelude::*;
 
@@ -88,20 +89,6 @@ pub struct FitReport {
     /// Vertices kept as they were because a face of theirs has a sample on
     /// two bodies.
     pub frozen: usize,
-}
-
-/// Lattice divisions of a face with corners `p` and sizes `h`: the
-/// estimate's rule (samples about `h_min/2` apart, 5 to 16 divisions).
-fn divisions(p: &[[f64; 3]; 3], h: &[f64; 3]) -> usize {
-    let longest = (0..3)
-        .map(|k| norm(sub(p[k], p[(k + 1) % 3])))
-        .fold(0.0, f64::max);
-    let h_min = h[0].min(h[1]).min(h[2]);
-    if h_min > 0.0 && longest.is_finite() {
-        (2.0 * longest / h_min).ceil().clamp(5.0, 16.0) as usize
-    } else {
-        5
-    }
 }
 
 /// Samples face `f` and returns its block (zero where its samples cannot
@@ -281,18 +268,4 @@ pub fn fit_sizes(mesh: &mut HalfedgeMesh, target: &Target, t_size: f64) -> FitRe
         mesh.vertex_size[v as usize] *= clamped;
     }
     report
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn divisions_follow_the_estimate_rule() {
-        let p = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-        assert_eq!(divisions(&p, &[1.0; 3]), 5);
-        assert_eq!(divisions(&p, &[0.2; 3]), 15);
-        assert_eq!(divisions(&p, &[0.01; 3]), 16);
-        assert_eq!(divisions(&p, &[0.0, 1.0, 1.0]), 5);
-    }
 }
