@@ -275,6 +275,21 @@ pub fn divisions(p: &[[f64; 3]; 3], h: &[f64; 3]) -> usize {
     }
 }
 
+/// The interior points of the barycentric lattice with `n` divisions on the
+/// triangle with corners `p`: each point's barycentric weights and position,
+/// in a fixed order (`(n−1)(n−2)/2` points).
+pub fn lattice(p: &[[f64; 3]; 3], n: usize) -> impl Iterator<Item = ([f64; 3], [f64; 3])> + '_ {
+    let inv = 1.0 / n as f64;
+    (1..n).flat_map(move |i| {
+        (1..n - i).map(move |j| {
+            let k = n - i - j;
+            let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
+            let q = add(add(scale(p[0], a), scale(p[1], b)), scale(p[2], c));
+            ([a, b, c], q)
+        })
+    })
+}
+
 /// How sampling one triangle ended.
 enum Lattice {
     /// Every sample taken, none on two bodies.
@@ -298,41 +313,35 @@ fn sample_triangle(
     hint: &mut u32,
     out: &mut Sampled,
 ) -> Lattice {
-    let inv = 1.0 / n as f64;
     let mut contact = false;
-    for i in 1..n {
-        for j in 1..n - i {
-            let k = n - i - j;
-            let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
-            let p = add(add(scale(t.p[0], a), scale(t.p[1], b)), scale(t.p[2], c));
-            let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
-            let Some(hit) = target.on_patch(p, t.patch, *hint) else {
-                *out = Sampled {
-                    ds: f64::INFINITY,
-                    dd: f64::INFINITY,
-                    de: f64::INFINITY,
-                    dc: f64::INFINITY,
-                };
-                return Lattice::Stop;
+    for ([a, b, c], p) in lattice(&t.p, n) {
+        let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
+        let Some(hit) = target.on_patch(p, t.patch, *hint) else {
+            *out = Sampled {
+                ds: f64::INFINITY,
+                dd: f64::INFINITY,
+                de: f64::INFINITY,
+                dc: f64::INFINITY,
             };
-            *hint = hit.index;
-            let r = if s_data > 0.0 && hit.size > 0.0 {
-                (s_data / hit.size).max(hit.size / s_data)
-            } else {
-                f64::INFINITY
-            };
-            let before = *out;
-            out.ds = out.ds.max(r);
-            if hit.contact {
-                contact = true;
-                out.dc = out.dc.max(r);
-            }
-            if hit.dist > 0.0 {
-                out.distance(hit.dist, target.allowance(hit.index, hit.size, h_loc, lim));
-            }
-            if *out != before && out.score(lim) >= exit_at {
-                return Lattice::Stop;
-            }
+            return Lattice::Stop;
+        };
+        *hint = hit.index;
+        let r = if s_data > 0.0 && hit.size > 0.0 {
+            (s_data / hit.size).max(hit.size / s_data)
+        } else {
+            f64::INFINITY
+        };
+        let before = *out;
+        out.ds = out.ds.max(r);
+        if hit.contact {
+            contact = true;
+            out.dc = out.dc.max(r);
+        }
+        if hit.dist > 0.0 {
+            out.distance(hit.dist, target.allowance(hit.index, hit.size, h_loc, lim));
+        }
+        if *out != before && out.score(lim) >= exit_at {
+            return Lattice::Stop;
         }
     }
     if contact {

@@ -51,9 +51,9 @@
 //! are summed in face order and CG runs sequentially, so the bits do not
 //! depend on the thread count.
 
-use super::estimate::divisions;
+use super::estimate::{divisions, lattice};
 use super::target::Target;
-use crate::geometry::{add, scale, triangle_area};
+use crate::geometry::triangle_area;
 use crate::mesh::halfedge::{HalfedgeMesh, NONE};
 use rayon::prelude::*;
 
@@ -110,36 +110,27 @@ fn face_block(mesh: &HalfedgeMesh, target: &Target, f: u32) -> (Block, usize, bo
     let weight = triangle_area(p[0], p[1], p[2]) / count as f64;
     let patch = mesh.face_patch[f as usize];
     let mut hint = mesh.vertex_hint[corners[0] as usize];
-    let inv = 1.0 / n as f64;
     let mut taken = 0;
     let mut contact = false;
-    for i in 1..n {
-        for j in 1..n - i {
-            let k = n - i - j;
-            let lam = [i as f64 * inv, j as f64 * inv, k as f64 * inv];
-            let q = add(
-                add(scale(p[0], lam[0]), scale(p[1], lam[1])),
-                scale(p[2], lam[2]),
-            );
-            let Some(hit) = target.on_patch(q, patch, if hint == NONE { 0 } else { hint }) else {
-                continue;
-            };
-            hint = hit.index;
-            contact |= hit.contact;
-            let ht = hit.size;
-            if !(ht > 0.0 && ht.is_finite()) {
-                continue;
-            }
-            let w = weight / (ht * ht);
-            let a = [0, 1, 2].map(|c| lam[c] * h0[c] / ht);
-            for r in 0..3 {
-                block.b[r] += w * a[r];
-                for c in 0..3 {
-                    block.m[r][c] += w * a[r] * a[c];
-                }
-            }
-            taken += 1;
+    for (lam, q) in lattice(&p, n) {
+        let Some(hit) = target.on_patch(q, patch, if hint == NONE { 0 } else { hint }) else {
+            continue;
+        };
+        hint = hit.index;
+        contact |= hit.contact;
+        let ht = hit.size;
+        if !(ht > 0.0 && ht.is_finite()) {
+            continue;
         }
+        let w = weight / (ht * ht);
+        let a = [0, 1, 2].map(|c| lam[c] * h0[c] / ht);
+        for r in 0..3 {
+            block.b[r] += w * a[r];
+            for c in 0..3 {
+                block.m[r][c] += w * a[r] * a[c];
+            }
+        }
+        taken += 1;
     }
     (block, taken, contact)
 }
