@@ -423,7 +423,7 @@ typedef struct {
   double corner_angle_deg;
   // Largest turn of a face normal, degrees (default 60).
   double max_normal_turn_deg;
-  // Largest angle of a new triangle, degrees in [60, 180] (default 150).
+  // Largest angle of a new triangle, degrees in [60, 180] (default 170).
   double max_angle_deg;
   // 1 = local repair (relaxation, flips) after each batch (default 1).
   int32_t repair;

@@ -105,7 +105,7 @@ pub struct abgs_simplify_params {
     pub corner_angle_deg: f64,
     /// Largest turn of a face normal, degrees (default 60).
     pub max_normal_turn_deg: f64,
-    /// Largest angle of a new triangle, degrees in [60, 180] (default 150).
+    /// Largest angle of a new triangle, degrees in [60, 180] (default 170).
     pub max_angle_deg: f64,
     /// 1 = local repair (relaxation, flips) after each batch (default 1).
     pub repair: i32,

@@ -132,6 +132,11 @@ pub struct Sampled {
     /// Largest size ratio, either way, at points lying on two bodies (1 when
     /// none).
     pub dc: f64,
+    /// A check at the samples refused a cap (largest angle past
+    /// [`CAP_ANGLE_DEG`]; score 1): [`Binding::NormalTurn`] when its normal
+    /// is more than the turn limit away from the target's where a sample
+    /// landed, [`Binding::MaxAngle`] when it has a sample on two bodies.
+    pub refused: Option<Binding>,
 }
 
 impl Sampled {
@@ -141,6 +146,7 @@ impl Sampled {
         dd: 0.0,
         de: 0.0,
         dc: 1.0,
+        refused: None,
     };
 
     /// Takes in a distance `d` with envelope `allow` there.
@@ -155,6 +161,9 @@ impl Sampled {
     /// The score of what was found: [`score`] with the contact term
     /// `(dc − 1)/(T_contact − 1)` beside the others.
     pub fn score(&self, lim: &Limits) -> f64 {
+        if self.refused.is_some() {
+            return 1.0;
+        }
         let y = score(self.ds, self.de, self.dd, lim);
         if self.dc > 1.0 {
             let c = 0.5 * (self.dc - 1.0) / (lim.t_contact - 1.0);
@@ -170,6 +179,9 @@ impl Sampled {
 
     /// The term that sets the score (`Free` when it is below ½).
     pub fn binding(&self, lim: &Limits) -> Binding {
+        if let Some(why) = self.refused {
+            return why;
+        }
         if self.score(lim) < 0.5 {
             return Binding::Free;
         }
@@ -211,6 +223,12 @@ pub fn score(ds: f64, de: f64, dd: f64, lim: &Limits) -> f64 {
         y.clamp(0.0, 1.0)
     }
 }
+
+/// Largest angle (degrees) past which a new face is a cap whose normal is
+/// also checked against the target's at its samples: the old default angle
+/// limit, under which the turn check against the replaced face alone kept
+/// every face of every measured run within the turn limit of the surface.
+pub const CAP_ANGLE_DEG: f64 = 150.0;
 
 /// One triangle to sample: corners, sizes at the corners, and its patch.
 #[derive(Debug, Clone, Copy)]
@@ -314,6 +332,16 @@ fn sample_triangle(
     out: &mut Sampled,
 ) -> Lattice {
     let mut contact = false;
+    // A cap must also face the way the target does where it lands: the
+    // normal-turn check of `face_ok` compares a face with the one it
+    // replaces, which lets a cap drift away from the surface over several
+    // collapses (see `DEFAULT_MAX_ANGLE_DEG`).
+    let cap = max_angle_deg(t.p) > CAP_ANGLE_DEG;
+    let normal = if cap {
+        reliable_normal(t.p[0], t.p[1], t.p[2])
+    } else {
+        None
+    };
     for ([a, b, c], p) in lattice(&t.p, n) {
         let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
         let Some(hit) = target.on_patch(p, t.patch, *hint) else {
@@ -322,10 +350,17 @@ fn sample_triangle(
                 dd: f64::INFINITY,
                 de: f64::INFINITY,
                 dc: f64::INFINITY,
+                refused: None,
             };
             return Lattice::Stop;
         };
         *hint = hit.index;
+        if let (Some(n), Some(m)) = (normal, target.unit_normal(hit.index)) {
+            if dot(n, m) < lim.cos_turn {
+                out.refused = Some(Binding::NormalTurn);
+                return Lattice::Stop;
+            }
+        }
         let r = if s_data > 0.0 && hit.size > 0.0 {
             (s_data / hit.size).max(hit.size / s_data)
         } else {
@@ -343,6 +378,14 @@ fn sample_triangle(
         if *out != before && out.score(lim) >= exit_at {
             return Lattice::Stop;
         }
+    }
+    if contact && cap {
+        // Where bodies touch, two independent triangulations must agree at
+        // every point, not only at the samples; between samples they drift
+        // apart with each interpolant's gradient, which a cap makes steep
+        // (a size difference over its small height). Caps stay off contacts.
+        out.refused = Some(Binding::MaxAngle);
+        return Lattice::Stop;
     }
     if contact {
         Lattice::Contact
@@ -609,6 +652,9 @@ fn evaluate(
     let mut sample_hint = hint;
     if found.score(lim) < exit_at {
         let s = sample_fan(target, &fan, h_loc, lim, exit_at, &mut sample_hint);
+        if let Some(why) = s.refused {
+            return invalid(why);
+        }
         found.ds = s.ds;
         found.dd = found.dd.max(s.dd);
         found.de = found.de.max(s.de);
@@ -640,5 +686,43 @@ mod tests {
         assert_eq!(divisions(&p, &[0.2; 3]), 15);
         assert_eq!(divisions(&p, &[0.01; 3]), 16);
         assert_eq!(divisions(&p, &[0.0, 1.0, 1.0]), 5);
+    }
+
+    /// An isosceles cap with largest angle `a` (degrees) on a unit base.
+    fn cap(a: f64) -> [[f64; 3]; 3] {
+        let height = 0.5 * ((180.0 - a) / 2.0).to_radians().tan();
+        [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, height, 0.0]]
+    }
+
+    #[test]
+    fn default_max_angle_keeps_cap_normals_reliable() {
+        use crate::simplify::DEFAULT_MAX_ANGLE_DEG;
+        let lim = crate::simplify::SimplifyParams::default().limits();
+        let flat = cap(120.0);
+        // A cap at the limit passes, with a normal the checks trust, at least
+        // 4 % of its base high; one past it is refused as the angle rule's.
+        let at = cap(DEFAULT_MAX_ANGLE_DEG - 0.5);
+        assert!((max_angle_deg(at) - (DEFAULT_MAX_ANGLE_DEG - 0.5)).abs() < 1e-9);
+        assert!(at[2][1] > 0.04);
+        assert!(reliable_normal(at[0], at[1], at[2]).is_some());
+        assert_eq!(face_ok(flat, at, [0.0, 0.0, 1.0], &lim), Ok(()));
+        let past = cap(DEFAULT_MAX_ANGLE_DEG + 0.5);
+        assert!(reliable_normal(past[0], past[1], past[2]).is_some());
+        assert_eq!(
+            face_ok(flat, past, [0.0, 0.0, 1.0], &lim),
+            Err(Binding::MaxAngle)
+        );
+        // Caps flatter than about 177.7° have noise for a normal: degenerate
+        // whatever the angle limit.
+        let noise = cap(178.0);
+        assert!(reliable_normal(noise[0], noise[1], noise[2]).is_none());
+        let open = Limits {
+            max_angle_deg: 180.0,
+            ..lim
+        };
+        assert_eq!(
+            face_ok(flat, noise, [0.0, 0.0, 1.0], &open),
+            Err(Binding::Degenerate)
+        );
     }
 }

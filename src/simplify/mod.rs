@@ -62,6 +62,43 @@ use std::time::Instant;
 /// disagreement p95 of 13.2 / 8.1 / 5.2 / 4.8 %.
 pub const DEFAULT_T_CONTACT: f64 = 1.2;
 
+/// Default largest angle of a new triangle ([`SimplifyParams::max_angle_deg`],
+/// degrees).
+///
+/// What the limit guards, and what it does not:
+/// - **Not the sizes.** The samples of the size test lie on a lattice whose
+///   spacing follows the longest side (see [`estimate::divisions`]), so a
+///   cap's interpolated sizes are measured as densely as any triangle's.
+/// - **Not the query's landing.** The distance envelope bounds a sample's
+///   distance whatever the face's tilt (see [`envelope`]), and the wrong-sheet
+///   share checks orientation after the fact.
+/// - **The normal.** A cap (largest angle `A`, longest side `L`) is at most
+///   `½·L·tan((180° − A)/2)` high, and a corner off its plane by `ε` tilts its
+///   normal by about `ε / height`. At 170° an isosceles cap is 4.4 % of its
+///   longest side high (at 150°, 13 %): a corner 1 % of `L` off its plane (a
+///   chord `L` on a radius `12.5·L`) tilts it by about 13°. Faces lower than
+///   1 % of their longest side have noise for a normal and are refused as
+///   degenerate ([`crate::mesh::shape::reliable_normal`]: an isosceles cap of
+///   about 177.7°). A tilt the cap's shape allows is caught where it
+///   matters: every sample of a new face checks the face's normal against
+///   the target's where it lands, within the normal-turn limit (the check
+///   against the face it replaces alone let caps drift from a sphere's
+///   surface over several collapses at 170°, `tests/simplify.rs`).
+/// - **Contacts.** Where bodies touch, two independent triangulations must
+///   agree at every point, not only at the samples, and between samples
+///   they drift apart with each interpolant's gradient, which a cap makes
+///   steep (a size difference over its small height). A cap with a sample on
+///   two bodies is refused (as the angle rule's): at 170° without this,
+///   `tests/contact.rs`'s shaft in a bore disagreed by 5.4 % at most
+///   against the 5.0 % it allows.
+///
+/// Measured against 150° on the shared models below 250k dense faces
+/// (README, "Largest angle"): the angle rule bound 11–27 % of the final
+/// edges at 150° and 1–8 % at 170°; elements per cell 0.99–1.24× (t20
+/// 33.1 → 34.4, cessna 49.6 → 61.6, crankarm 107.7 → 118.7), size deviation
+/// p95 ≤ 1.132 and wrong-sheet share ≤ 3e-5 on every one.
+pub const DEFAULT_MAX_ANGLE_DEG: f64 = 170.0;
+
 /// Which scorer ranks the edges (see [`scorer`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
@@ -142,10 +179,12 @@ pub struct SimplifyParams {
     /// (default 30).
     pub corner_angle_deg: f64,
     /// Largest turn of a face normal a collapse, move or flip may cause
-    /// (degrees, default 60).
+    /// (degrees, default 60): against the face it replaces, and against the
+    /// target's normal at every sample of the new face.
     pub max_normal_turn_deg: f64,
-    /// Largest angle of a new triangle (degrees, default 150) unless the
-    /// triangle it replaces already had a larger one.
+    /// Largest angle of a new triangle (degrees, default
+    /// [`DEFAULT_MAX_ANGLE_DEG`] = 170) unless the triangle it replaces
+    /// already had a larger one.
     pub max_angle_deg: f64,
     /// Local repair after each batch (relaxation and flips; default true).
     pub repair: bool,
@@ -175,7 +214,7 @@ impl Default for SimplifyParams {
             feature_angle_deg: 30.0,
             corner_angle_deg: 30.0,
             max_normal_turn_deg: 60.0,
-            max_angle_deg: 150.0,
+            max_angle_deg: DEFAULT_MAX_ANGLE_DEG,
             repair: true,
             fit_sizes: true,
         }

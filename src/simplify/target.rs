@@ -19,8 +19,9 @@
 
 use super::envelope::Envelope;
 use super::estimate::Limits;
-use crate::geometry::lerp;
+use crate::geometry::{cross, lerp, sub};
 use crate::mesh::feature_lines::FeatureLines;
+use crate::mesh::shape::unit;
 use crate::mesh::Grid;
 use crate::spatial::StarMesh;
 
@@ -90,6 +91,16 @@ impl<'a> Target<'a> {
             None => (0.0, f64::INFINITY),
         };
         lim.size_term.allowance(h, h_loc, g).min(lim.kappa * c)
+    }
+
+    /// Unit normal of target triangle `tri` (`None` when it is degenerate or
+    /// out of range). O(1).
+    #[inline]
+    pub fn unit_normal(&self, tri: u32) -> Option<[f64; 3]> {
+        let t = self.grid.triangles().get(tri as usize)?;
+        let v = self.grid.vertices();
+        let [a, b, c] = t.map(|i| v[i as usize]);
+        unit(cross(sub(b, a), sub(c, a)))
     }
 
     /// Closest point of `p` on patch `patch` (anywhere on the target when the

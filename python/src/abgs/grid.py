@@ -558,7 +558,7 @@ class Grid:
         selection; about 3x slower), t_contact 1.2 (where bodies touch; lower makes touching bodies' own fields agree, at a cost in faces),
         tau_d 0 (derived envelope),
         max_distance 0 (none), max_iterations 1000, feature and corner angle
-        30°, normal turn 60°, max angle 150°, repair on, beta 1.2,
+        30°, normal turn 60°, max angle 170°, repair on, beta 1.2,
         clearance_fraction 0.25, fit_sizes on (the vertex sizes fitted to
         this grid's field at the end, by element-weighted least squares;
         off: each vertex keeps this grid's size at its position, the
