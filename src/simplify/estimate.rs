@@ -225,9 +225,10 @@ pub fn score(ds: f64, de: f64, dd: f64, lim: &Limits) -> f64 {
 }
 
 /// Largest angle (degrees) past which a new face is a cap whose normal is
-/// also checked against the target's at its samples: the old default angle
-/// limit, under which the turn check against the replaced face alone kept
-/// every face of every measured run within the turn limit of the surface.
+/// also checked against the target's at its samples, and which may not lie
+/// on a contact: the old default angle limit, under which the turn check
+/// against the replaced face alone passed `tests/simplify.rs`'s check of
+/// every face against the surface after every iteration.
 pub const CAP_ANGLE_DEG: f64 = 150.0;
 
 /// One triangle to sample: corners, sizes at the corners, and its patch.

@@ -80,8 +80,8 @@ pub const DEFAULT_T_CONTACT: f64 = 1.2;
 ///   1 % of their longest side have noise for a normal and are refused as
 ///   degenerate ([`crate::mesh::shape::reliable_normal`]: an isosceles cap of
 ///   about 177.7°). A tilt the cap's shape allows is caught where it
-///   matters: every sample of a new face checks the face's normal against
-///   the target's where it lands, within the normal-turn limit (the check
+///   matters: every sample of a cap (past [`estimate::CAP_ANGLE_DEG`]) checks
+///   the cap's normal against the target's where it lands, within the normal-turn limit (the check
 ///   against the face it replaces alone let caps drift from a sphere's
 ///   surface over several collapses at 170°, `tests/simplify.rs`).
 /// - **Contacts.** Where bodies touch, two independent triangulations must
@@ -179,8 +179,9 @@ pub struct SimplifyParams {
     /// (default 30).
     pub corner_angle_deg: f64,
     /// Largest turn of a face normal a collapse, move or flip may cause
-    /// (degrees, default 60): against the face it replaces, and against the
-    /// target's normal at every sample of the new face.
+    /// (degrees, default 60): against the face it replaces, and for a cap
+    /// (largest angle past [`estimate::CAP_ANGLE_DEG`]) also against the
+    /// target's normal at each of its samples.
     pub max_normal_turn_deg: f64,
     /// Largest angle of a new triangle (degrees, default
     /// [`DEFAULT_MAX_ANGLE_DEG`] = 170) unless the triangle it replaces
