@@ -1,6 +1,7 @@
 //! The background grid: an immutable triangle surface with one size per vertex,
 //! its adjacency, its BVH and the report of what was found on input.
 
+mod contact_lists;
 pub mod feature_lines;
 pub mod features;
 pub mod halfedge;
@@ -11,6 +12,7 @@ mod topology;
 mod validate;
 pub mod weld;
 
+pub(crate) use contact_lists::MAX_LIST as MAX_CONTACT_LIST;
 pub use features::Features;
 pub use restore::{GridParts, InputHistory};
 pub use stats::{AngleStats, GridStats};
@@ -79,6 +81,9 @@ pub struct Grid {
     /// Per triangle: may another body's face lie within the contact gap of
     /// it? Computed on first use ([`Grid::contact_faces`]).
     contact_faces: std::sync::OnceLock<Vec<bool>>,
+    /// Per contact face: the other bodies' faces that may lie within the
+    /// contact gap of it. Computed on first use ([`Grid::contact_lists`]).
+    contact_lists: std::sync::OnceLock<contact_lists::ContactLists>,
     /// Per BVH node: the body of every triangle below it, or
     /// [`crate::spatial::MIXED_LABEL`]. Computed on first use
     /// ([`Grid::node_bodies`]).
@@ -279,6 +284,7 @@ impl Grid {
             bvh,
             report,
             contact_faces: std::sync::OnceLock::new(),
+            contact_lists: std::sync::OnceLock::new(),
             node_bodies: std::sync::OnceLock::new(),
         };
         if let Some(s) = sizes {
@@ -444,6 +450,14 @@ impl Grid {
                 })
                 .collect()
         })
+    }
+
+    /// Per contact face, the other bodies' faces that may lie within the
+    /// contact gap of any of its points (see [`contact_lists`]). Computed
+    /// once, on first use: O(Fc log F) for Fc contact faces.
+    pub(crate) fn contact_lists(&self) -> &contact_lists::ContactLists {
+        self.contact_lists
+            .get_or_init(|| contact_lists::ContactLists::build(self))
     }
 
     /// Per BVH node: the body every triangle below it belongs to, or

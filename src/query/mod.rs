@@ -137,11 +137,57 @@ impl Grid {
         if topo.body_count < 2 || !self.contact_faces()[tri as usize] {
             return size;
         }
-        let own = topo.face_body[tri as usize];
-        self.other_bodies_within(q, own, self.contact_gap())
+        self.other_bodies_at(q, tri)
             .iter()
             .map(|&(t, b)| interpolate(self.triangles()[t as usize].map(|v| s[v as usize]), b))
             .fold(size, f64::min)
+    }
+
+    /// [`Grid::other_bodies_within`] for a point `q` on triangle `tri` (its
+    /// closest point, say), reach [`Grid::contact_gap`], own body `tri`'s:
+    /// the same answer bit for bit, read from `tri`'s contact list when it
+    /// has one (see [`crate::mesh`]'s contact lists), else by the BVH. O(k)
+    /// for k listed faces.
+    pub(crate) fn other_bodies_at(
+        &self,
+        q: [f64; 3],
+        tri: u32,
+    ) -> arrayvec::ArrayVec<(u32, [f64; 3]), { MAX_TIED_BODIES - 1 }> {
+        let body = &self.topology().face_body;
+        let own = body[tri as usize];
+        let gap = self.contact_gap();
+        let Some(list) = self.contact_lists().get(tri) else {
+            return self.other_bodies_within(q, own, gap);
+        };
+        let bvh = self.bvh();
+        // The best face of each body within the gap, as (d², face, bary).
+        let mut best: arrayvec::ArrayVec<
+            (u32, f64, u32, [f64; 3]),
+            { crate::mesh::MAX_CONTACT_LIST },
+        > = arrayvec::ArrayVec::new();
+        let r2 = gap * gap;
+        for &u in list {
+            let c = &bvh.prim_corners[bvh.triangle_prim[u as usize] as usize];
+            let cp = crate::geometry::closest_point_triangle(q, c[0], c[1], c[2]);
+            if cp.dist2 > r2 {
+                continue;
+            }
+            let b = body[u as usize];
+            match best.iter_mut().find(|e| e.0 == b) {
+                Some(e) => {
+                    if cp.dist2 < e.1 || (cp.dist2 == e.1 && u < e.2) {
+                        *e = (b, cp.dist2, u, cp.bary);
+                    }
+                }
+                None => best.push((b, cp.dist2, u, cp.bary)),
+            }
+        }
+        // Nearest body first, ties to the lower face: the BVH's order.
+        best.sort_unstable_by(|x, y| x.1.total_cmp(&y.1).then(x.2.cmp(&y.2)));
+        best.iter()
+            .take(MAX_TIED_BODIES - 1)
+            .map(|e| (e.2, e.3))
+            .collect()
     }
 
     /// The closest point of `p` on each body other than `own` with a face

@@ -15,7 +15,9 @@
 //! [`super::estimate::Limits::t_contact`]). Both bodies then follow one field
 //! closely wherever they touch, whatever their triangles, and so agree with
 //! each other. Which target triangles come near another body is found once
-//! ([`Grid::contact_faces`], conservative), so the extra search is paid only there.
+//! ([`Grid::contact_faces`], conservative), so the extra search is paid only
+//! there, and it reads a short list of the other bodies' faces near each such
+//! triangle instead of searching the BVH from its root ([`Grid::other_bodies_at`]).
 
 use super::envelope::Envelope;
 use super::estimate::Limits;
@@ -142,12 +144,10 @@ impl<'a> Target<'a> {
     /// The agreed size at point `q` of target triangle `tri` (size `size`
     /// there): the smallest of the sizes of the bodies with a face within the
     /// contact gap of `q`, each at its own closest point, and whether any
-    /// other body was found. O(log F) per body.
+    /// other body was found. O(k) from `tri`'s contact list of k faces
+    /// ([`Grid::other_bodies_at`]), O(log F) per body where it has none.
     fn agreed(&self, q: [f64; 3], tri: u32, size: f64) -> (f64, bool) {
-        let own = self.grid.topology().face_body[tri as usize];
-        let others = self
-            .grid
-            .other_bodies_within(q, own, self.grid.contact_gap());
+        let others = self.grid.other_bodies_at(q, tri);
         let best = others
             .iter()
             .map(|&(t, b)| {

@@ -1,0 +1,271 @@
+//! Contact lists: for each face that another body comes near
+//! ([`Grid::contact_faces`]), the other bodies' faces that can lie within the
+//! contact gap of any point of it. The tie rule between bodies (the size
+//! queries' and the simplifier's agreed sizes) then reads a short list instead
+//! of searching the BVH from the root, once per body found and once more to
+//! learn that no further body is there.
+//!
+//! # Why the list answers exactly
+//!
+//! For face `t` with centroid `m` and `r` its largest centroid–corner
+//! distance, every point `q` of `t` lies within `r` of `m`. A face `u` with
+//! `|q − u| ≤ c` (the contact gap) therefore has `|m − u| ≤ r + c`, so the
+//! list holds every face of another body whose computed distance to `m` is at
+//! most `R = (r + c)(1 + 1e-9) + 8s`, `s` being the BVH's rounding scale
+//! (`1e-12` of the largest coordinate magnitude): the margins cover the
+//! rounding of `m`, `r`, the distances and of a closest point `q` computed on
+//! `t`. A query at such a `q` then evaluates each listed face exactly as the
+//! BVH's search does (the same corners, the same point–triangle distance),
+//! keeps those within `c`, the best face of each body by (distance, index),
+//! and takes the bodies in that order: [`Grid::other_bodies_within`]'s answer
+//! bit for bit, for any `q` on `t`.
+//!
+//! # Cost and ties
+//!
+//! Built on first use: one bounded BVH range search per contact face,
+//! parallel in fixed chunks (so the lists are the same for any thread count),
+//! O(Fc log F). Memory: 4 bytes per face (offsets) plus 4 per listed face. A
+//! list longer than [`MAX_LIST`] (another body's faces far finer than this
+//! one's) is not kept: such a face answers through the BVH, as before. A
+//! lookup is O(k) point–triangle distances for k listed faces (a few on
+//! coincident faces of similar size). Ties the tie rule to the BVH's corners
+//! and distance function, and to [`Grid::contact_faces`]' radius.
+
+use super::Grid;
+use crate::geometry::closest_point_triangle;
+use crate::spatial::Bvh;
+use arrayvec::ArrayVec;
+use rayon::prelude::*;
+
+/// Longest list kept; a face with more candidates answers through the BVH.
+pub(crate) const MAX_LIST: usize = 64;
+
+/// Faces per parallel chunk when building (a constant: same lists whatever
+/// the thread count).
+const CHUNK: usize = 4096;
+
+/// Marks a face whose list overflowed [`MAX_LIST`].
+const OVERFLOW: u32 = u32::MAX;
+
+/// Per face, the other bodies' faces that may lie within the contact gap of
+/// it (compressed rows; see the module doc).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct ContactLists {
+    /// Start of each face's list in `faces` (one more than the faces).
+    offsets: Vec<u32>,
+    /// The listed faces, in the BVH's leaf order; `[OVERFLOW]` for a face
+    /// whose list was too long.
+    faces: Vec<u32>,
+}
+
+impl ContactLists {
+    /// The lists of `grid`'s contact faces (empty on one body). O(Fc log F).
+    pub(crate) fn build(grid: &Grid) -> ContactLists {
+        let contact = grid.contact_faces();
+        if contact.is_empty() {
+            return ContactLists::default();
+        }
+        let (bvh, v, t) = (grid.bvh(), grid.vertices(), grid.triangles());
+        let body = &grid.topology().face_body;
+        let nodes = grid.node_bodies();
+        let gap = grid.contact_gap();
+        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..t.len())
+            .collect::<Vec<_>>()
+            .par_chunks(CHUNK)
+            .map(|fs| {
+                let (mut lens, mut items) = (Vec::with_capacity(fs.len()), Vec::new());
+                for &f in fs {
+                    let before = items.len();
+                    if contact[f] {
+                        let [a, b, c] = t[f].map(|i| v[i as usize]);
+                        let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+                        let r = [a, b, c]
+                            .iter()
+                            .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
+                            .fold(0.0, f64::max);
+                        let s = 1e-12 * m.iter().fold(bvh.coord_scale, |x, c| x.max(c.abs()));
+                        let reach = (r + gap) * (1.0 + 1e-9) + 8.0 * s;
+                        let own = body[f];
+                        let full = within(
+                            bvh,
+                            m,
+                            reach * reach,
+                            |u| body[u as usize] != own,
+                            |n| nodes[n] != own,
+                            &mut items,
+                        );
+                        if !full {
+                            items.truncate(before);
+                            items.push(OVERFLOW);
+                        }
+                    }
+                    lens.push((items.len() - before) as u32);
+                }
+                (lens, items)
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(t.len() + 1);
+        offsets.push(0u32);
+        let mut faces = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
+        for (lens, items) in chunks {
+            for l in lens {
+                offsets.push(offsets.last().copied().unwrap_or(0) + l);
+            }
+            faces.extend_from_slice(&items);
+        }
+        ContactLists { offsets, faces }
+    }
+
+    /// The list of face `f`: `None` when there is none kept (not a contact
+    /// face, an overflowing list, or an index out of range). O(1).
+    pub(crate) fn get(&self, f: u32) -> Option<&[u32]> {
+        let f = f as usize;
+        let (a, b) = (
+            *self.offsets.get(f)? as usize,
+            *self.offsets.get(f + 1)? as usize,
+        );
+        let list = &self.faces[a..b];
+        (!list.is_empty() && list[0] != OVERFLOW).then_some(list)
+    }
+}
+
+/// Appends to `out` every triangle accepted by `keep` whose computed squared
+/// distance to `p` is at most `r2`, in leaf order, searching nodes whose box
+/// lies within `r2` (padded as the BVH pads) and that `keep_node` accepts.
+/// False (with `out` partly filled) once more than [`MAX_LIST`] were found.
+fn within(
+    bvh: &Bvh,
+    p: [f64; 3],
+    r2: f64,
+    keep: impl Fn(u32) -> bool,
+    keep_node: impl Fn(usize) -> bool,
+    out: &mut Vec<u32>,
+) -> bool {
+    let Some(root) = bvh.nodes.first() else {
+        return true;
+    };
+    let s = 1e-12 * p.iter().fold(bvh.coord_scale, |m, c| m.max(c.abs()));
+    let limit = r2 * (1.0 + 1e-12) + s * (2.0 * r2.sqrt() + s);
+    if root.bbox.distance2(&p) > limit {
+        return true;
+    }
+    let start = out.len();
+    let mut stack: ArrayVec<u32, { crate::spatial::MAX_DEPTH + 1 }> = ArrayVec::new();
+    stack.push(0);
+    while let Some(ni) = stack.pop() {
+        let ni = ni as usize;
+        if !keep_node(ni) {
+            continue;
+        }
+        let n = &bvh.nodes[ni];
+        if n.is_leaf() {
+            let s0 = n.start as usize;
+            for slot in s0..s0 + n.count as usize {
+                let u = bvh.prim_triangle[slot];
+                let c = &bvh.prim_corners[slot];
+                if keep(u) && closest_point_triangle(p, c[0], c[1], c[2]).dist2 <= r2 {
+                    if out.len() - start == MAX_LIST {
+                        return false;
+                    }
+                    out.push(u);
+                }
+            }
+            continue;
+        }
+        // Right child pushed first so the left is searched first; one net
+        // entry per level keeps the stack within the depth bound.
+        let (l, r) = (ni + 1, n.start as usize);
+        if bvh.nodes[r].bbox.distance2(&p) <= limit {
+            stack.push(r as u32);
+        }
+        if bvh.nodes[l].bbox.distance2(&p) <= limit {
+            stack.push(l as u32);
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::mesh::{BuildOptions, Grid};
+    use crate::test_shapes::{rng, unit_square};
+
+    /// Five wavy unit squares, each its own body, stacked within the contact
+    /// gap of each other (so a point meets up to four other bodies, one more
+    /// than a query reads) at resolutions 3 to 48 (so coarse faces overflow
+    /// their lists and fine faces keep short ones), and a sixth one apart.
+    fn stack() -> Grid {
+        let (mut v, mut t) = (Vec::new(), Vec::new());
+        let layers = [
+            (6, 0.0),
+            (48, 1.5e-4),
+            (3, 3.1e-4),
+            (17, 2.2e-4),
+            (9, 0.9e-4),
+            (5, 0.1),
+        ];
+        for (n, dz) in layers {
+            let (lv, lt) = unit_square(n, |x, y| dz + 0.02 * (3.0 * x).sin() * (2.0 * y).cos());
+            let base = v.len() as u32;
+            v.extend(lv);
+            t.extend(lt.iter().map(|f| f.map(|i| i + base)));
+        }
+        Grid::from_arrays(v, t, None, &BuildOptions::default()).unwrap()
+    }
+
+    #[test]
+    fn lists_answer_as_the_bvh_bit_for_bit() {
+        let g = stack();
+        assert_eq!(g.topology().body_count, 6);
+        let gap = g.contact_gap();
+        let (contact, lists) = (g.contact_faces(), g.contact_lists());
+        let listed = (0..g.triangles().len() as u32)
+            .filter(|&f| lists.get(f).is_some())
+            .count();
+        let flagged = contact.iter().filter(|&&c| c).count();
+        // Both kinds occur: kept lists and overflowing (or empty) ones.
+        assert!(listed > 1000 && listed < flagged, "{listed} of {flagged}");
+        let body = &g.topology().face_body;
+        let mut seed = 11u64;
+        let (mut compared, mut most) = (0, 0);
+        for i in 0..20000 {
+            let f = (rng(&mut seed) * g.triangles().len() as f64) as usize;
+            if !contact[f] {
+                continue;
+            }
+            // Corners, edge points and inner points of the face, as its
+            // closest points: how the tie rule calls it.
+            let c = g.triangles()[f].map(|k| g.vertices()[k as usize]);
+            let (a, b) = match i % 3 {
+                0 => (1.0, 0.0),
+                1 => (rng(&mut seed), 0.0),
+                _ => (rng(&mut seed) * 0.5, rng(&mut seed) * 0.5),
+            };
+            let p = [0, 1, 2].map(|k| c[0][k] + a * (c[1][k] - c[0][k]) + b * (c[2][k] - c[0][k]));
+            let q = g
+                .bvh()
+                .closest_filtered(p, None, |u| u == f as u32)
+                .unwrap();
+            let fast = g.other_bodies_at(q.closest.point, f as u32);
+            let slow = g.other_bodies_within(q.closest.point, body[f], gap);
+            assert_eq!(fast.len(), slow.len(), "face {f}");
+            for (x, y) in fast.iter().zip(&slow) {
+                assert_eq!(x.0, y.0, "face {f}");
+                assert_eq!(x.1.map(f64::to_bits), y.1.map(f64::to_bits), "face {f}");
+            }
+            compared += usize::from(lists.get(f as u32).is_some());
+            most = most.max(fast.len());
+        }
+        assert!(compared > 1000, "{compared}");
+        // The cap of three other bodies was reached and kept.
+        assert_eq!(most, 3);
+    }
+
+    #[test]
+    fn one_body_has_no_lists() {
+        let (v, t) = unit_square(4, |_, _| 0.0);
+        let g = Grid::from_arrays(v, t, None, &BuildOptions::default()).unwrap();
+        assert!(g.contact_lists().get(0).is_none());
+        assert!(g.contact_lists().faces.is_empty());
+    }
+}
