@@ -26,6 +26,22 @@ pub fn closest_point_on_segment(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
 }
 
+/// Squared distance from `p` to the axis-aligned bounding box of triangle
+/// `c`: a lower bound of the triangle's own distance, for skipping a
+/// triangle before [`closest_point_triangle`] (callers pad the bound for
+/// rounding). O(1).
+#[inline(always)]
+pub fn triangle_box_distance2(c: &[[f64; 3]; 3], p: &[f64; 3]) -> f64 {
+    let mut d2 = 0.0;
+    for k in 0..3 {
+        let lo = c[0][k].min(c[1][k]).min(c[2][k]);
+        let hi = c[0][k].max(c[1][k]).max(c[2][k]);
+        let v = (lo - p[k]).max(0.0).max(p[k] - hi);
+        d2 += v * v;
+    }
+    d2
+}
+
 /// Exact closest point to `p` on triangle (a, b, c). O(1).
 ///
 /// Barycentric coordinates are clamped to the triangle; for a degenerate triangle

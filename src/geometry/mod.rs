@@ -4,7 +4,9 @@
 mod closest;
 mod vec3;
 
-pub use closest::{closest_point_on_segment, closest_point_triangle, ClosestPoint};
+pub use closest::{
+    closest_point_on_segment, closest_point_triangle, triangle_box_distance2, ClosestPoint,
+};
 pub use vec3::*;
 
 /// An axis-aligned bounding box.

@@ -174,7 +174,7 @@ impl Grid {
         let box_limit = (gap + s) * (gap + s) * (1.0 + 1e-12);
         for &u in list {
             let c = &bvh.prim_corners[bvh.triangle_prim[u as usize] as usize];
-            if box_distance2(c, &q) > box_limit {
+            if crate::geometry::triangle_box_distance2(c, &q) > box_limit {
                 continue;
             }
             let cp = crate::geometry::closest_point_triangle(q, c[0], c[1], c[2]);
@@ -249,20 +249,6 @@ impl Grid {
 pub(crate) fn interpolate(h: [f64; 3], b: [f64; 3]) -> f64 {
     let v = b[0] * h[0] + b[1] * h[1] + b[2] * h[2];
     v.clamp(h[0].min(h[1]).min(h[2]), h[0].max(h[1]).max(h[2]))
-}
-
-/// Squared distance from `p` to the bounding box of triangle `c`: at most
-/// the triangle's own distance. O(1).
-#[inline(always)]
-fn box_distance2(c: &[[f64; 3]; 3], p: &[f64; 3]) -> f64 {
-    let mut d2 = 0.0;
-    for k in 0..3 {
-        let lo = c[0][k].min(c[1][k]).min(c[2][k]);
-        let hi = c[0][k].max(c[1][k]).max(c[2][k]);
-        let v = (lo - p[k]).max(0.0).max(p[k] - hi);
-        d2 += v * v;
-    }
-    d2
 }
 
 /// Checks batch arguments: equal lengths and finite points.
