@@ -22,8 +22,9 @@
 //!
 //! # Cost and ties
 //!
-//! Built on first use: one bounded BVH range search per contact face,
-//! parallel in fixed chunks (so the lists are the same for any thread count),
+//! Built on first use: one bounded BVH range search per contact face, in
+//! fixed chunks (so the lists are the same for any thread count), parallel
+//! unless first reached on a rayon worker ([`super::on_rayon_worker`]),
 //! O(Fc log F). Memory: 4 bytes per face (offsets) plus 4 per listed face. A
 //! list longer than [`MAX_LIST`] (another body's faces far finer than this
 //! one's) is not kept: such a face answers through the BVH, as before. A
@@ -69,41 +70,43 @@ impl ContactLists {
         let body = &grid.topology().face_body;
         let nodes = grid.node_bodies();
         let gap = grid.contact_gap();
-        let chunks: Vec<(Vec<u32>, Vec<u32>)> = (0..t.len())
-            .collect::<Vec<_>>()
-            .par_chunks(CHUNK)
-            .map(|fs| {
-                let (mut lens, mut items) = (Vec::with_capacity(fs.len()), Vec::new());
-                for &f in fs {
-                    let before = items.len();
-                    if contact[f] {
-                        let [a, b, c] = t[f].map(|i| v[i as usize]);
-                        let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
-                        let r = [a, b, c]
-                            .iter()
-                            .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
-                            .fold(0.0, f64::max);
-                        let s = 1e-12 * m.iter().fold(bvh.coord_scale, |x, c| x.max(c.abs()));
-                        let reach = (r + gap) * (1.0 + 1e-9) + 8.0 * s;
-                        let own = body[f];
-                        let full = within(
-                            bvh,
-                            m,
-                            reach * reach,
-                            |u| body[u as usize] != own,
-                            |n| nodes[n] != own,
-                            &mut items,
-                        );
-                        if !full {
-                            items.truncate(before);
-                            items.push(OVERFLOW);
-                        }
+        let list_chunk = |fs: &[usize]| {
+            let (mut lens, mut items) = (Vec::with_capacity(fs.len()), Vec::new());
+            for &f in fs {
+                let before = items.len();
+                if contact[f] {
+                    let [a, b, c] = t[f].map(|i| v[i as usize]);
+                    let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+                    let r = [a, b, c]
+                        .iter()
+                        .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
+                        .fold(0.0, f64::max);
+                    let s = 1e-12 * m.iter().fold(bvh.coord_scale, |x, c| x.max(c.abs()));
+                    let reach = (r + gap) * (1.0 + 1e-9) + 8.0 * s;
+                    let own = body[f];
+                    let full = within(
+                        bvh,
+                        m,
+                        reach * reach,
+                        |u| body[u as usize] != own,
+                        |n| nodes[n] != own,
+                        &mut items,
+                    );
+                    if !full {
+                        items.truncate(before);
+                        items.push(OVERFLOW);
                     }
-                    lens.push((items.len() - before) as u32);
                 }
-                (lens, items)
-            })
-            .collect();
+                lens.push((items.len() - before) as u32);
+            }
+            (lens, items)
+        };
+        let all: Vec<usize> = (0..t.len()).collect();
+        let chunks: Vec<(Vec<u32>, Vec<u32>)> = if super::on_rayon_worker() {
+            all.chunks(CHUNK).map(list_chunk).collect()
+        } else {
+            all.par_chunks(CHUNK).map(list_chunk).collect()
+        };
         let mut offsets = Vec::with_capacity(t.len() + 1);
         offsets.push(0u32);
         let mut faces = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
@@ -259,6 +262,26 @@ mod tests {
         assert!(compared > 1000, "{compared}");
         // The cap of three other bodies was reached and kept.
         assert_eq!(most, 3);
+    }
+
+    #[test]
+    fn built_on_a_worker_or_not_the_same() {
+        let (g, h) = (stack(), stack());
+        // This test's thread is no rayon worker: a parallel build.
+        assert!(!crate::mesh::on_rayon_worker());
+        let (a, fa) = (g.contact_lists().clone(), g.contact_faces().to_vec());
+        // Inside `join` the closure runs on a worker: a sequential build.
+        let ((b, fb), _) = rayon::join(
+            || {
+                assert!(crate::mesh::on_rayon_worker());
+                (h.contact_lists().clone(), h.contact_faces().to_vec())
+            },
+            || (),
+        );
+        assert_eq!(fa, fb);
+        assert_eq!(a.offsets, b.offsets);
+        assert_eq!(a.faces, b.faces);
+        assert!(!a.faces.is_empty());
     }
 
     #[test]

@@ -416,7 +416,9 @@ impl Grid {
     /// around the triangle, padded by 1e-9 relative, is tested), so a `false`
     /// is certain: the tie rule and the simplifier's agreed sizes search for
     /// other bodies only on `true` triangles. Empty for a grid of one body.
-    /// Computed once, on first use: O(F log F), parallel, deterministic.
+    /// Computed once, on first use: O(F log F), deterministic; parallel
+    /// unless first called on a rayon worker thread (see
+    /// [`on_rayon_worker`]).
     pub fn contact_faces(&self) -> &[bool] {
         self.contact_faces.get_or_init(|| {
             use rayon::prelude::*;
@@ -428,33 +430,35 @@ impl Grid {
             let v = self.vertices();
             let body = &topo.face_body;
             let nodes = self.node_bodies();
-            self.triangles()
-                .par_iter()
-                .enumerate()
-                .map(|(f, tri)| {
-                    let [a, b, c] = tri.map(|i| v[i as usize]);
-                    let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
-                    let r = [a, b, c]
-                        .iter()
-                        .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
-                        .fold(0.0, f64::max);
-                    let own = body[f];
-                    self.bvh()
-                        .closest_filtered_within_pruned(
-                            m,
-                            (r + gap) * (1.0 + 1e-9),
-                            |t| body[t as usize] != own,
-                            |n| nodes[n] != own,
-                        )
-                        .is_some()
-                })
-                .collect()
+            let flag = |(f, tri): (usize, &[u32; 3])| {
+                let [a, b, c] = tri.map(|i| v[i as usize]);
+                let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+                let r = [a, b, c]
+                    .iter()
+                    .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
+                    .fold(0.0, f64::max);
+                let own = body[f];
+                self.bvh()
+                    .closest_filtered_within_pruned(
+                        m,
+                        (r + gap) * (1.0 + 1e-9),
+                        |t| body[t as usize] != own,
+                        |n| nodes[n] != own,
+                    )
+                    .is_some()
+            };
+            if on_rayon_worker() {
+                self.triangles().iter().enumerate().map(flag).collect()
+            } else {
+                self.triangles().par_iter().enumerate().map(flag).collect()
+            }
         })
     }
 
     /// Per contact face, the other bodies' faces that may lie within the
     /// contact gap of any of its points (see [`contact_lists`]). Computed
-    /// once, on first use: O(Fc log F) for Fc contact faces.
+    /// once, on first use: O(Fc log F) for Fc contact faces; parallel unless
+    /// first called on a rayon worker thread (see [`on_rayon_worker`]).
     pub(crate) fn contact_lists(&self) -> &contact_lists::ContactLists {
         self.contact_lists
             .get_or_init(|| contact_lists::ContactLists::build(self))
@@ -484,6 +488,18 @@ impl Grid {
     pub fn report(&self) -> &ValidationReport {
         &self.report
     }
+}
+
+/// True on a rayon worker thread. A lazy initialisation ([`Grid::contact_faces`],
+/// [`Grid::contact_lists`]) first reached from parallel work (batch queries,
+/// the simplifier's estimates) must not fork parallel work of its own: while
+/// waiting for it, the worker may run another of the caller's jobs, which
+/// reaches the same initialisation again on the same thread, and a
+/// `OnceLock` initialised reentrantly deadlocks. There it runs sequentially
+/// (the same result: each entry is computed on its own); callers that can
+/// initialise beforehand, outside the parallel work, do so.
+pub(crate) fn on_rayon_worker() -> bool {
+    rayon::current_thread_index().is_some()
 }
 
 /// Checks a grid's raw arrays: at least one vertex and one triangle, finite

@@ -114,6 +114,11 @@ impl Grid {
     pub fn query_sizes(&self, points: &[[f64; 3]], out: &mut [f64]) -> Result<()> {
         self.require_sizes()?;
         check_batch(points, out.len())?;
+        // The tie rule's lists, built here in parallel rather than lazily
+        // (and sequentially) by the first worker that needs them.
+        if self.topology().body_count > 1 {
+            self.contact_lists();
+        }
         points
             .par_chunks(BATCH_CHUNK)
             .zip(out.par_chunks_mut(BATCH_CHUNK))

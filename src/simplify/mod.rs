@@ -467,6 +467,11 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
     let lim = params.limits();
     let envelope = envelope::Envelope::compute(grid, sizes, &features, lim.size_term, lim.kappa);
     let reach = Target::star_mesh(grid, &features.face_patch).reaches();
+    // The tie rule's contact faces and lists, built here in parallel rather
+    // than lazily (and sequentially) inside the parallel estimates.
+    if grid.topology().body_count > 1 {
+        grid.contact_lists();
+    }
     Ok((
         mesh,
         TargetParts {
