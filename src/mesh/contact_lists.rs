@@ -107,9 +107,15 @@ impl ContactLists {
         } else {
             all.par_chunks(CHUNK).map(list_chunk).collect()
         };
+        let total: usize = chunks.iter().map(|c| c.1.len()).sum();
+        if u32::try_from(total).is_err() {
+            // Past 4-byte offsets (tens of millions of contact faces): no
+            // lists, every face asks the BVH.
+            return ContactLists::default();
+        }
         let mut offsets = Vec::with_capacity(t.len() + 1);
         offsets.push(0u32);
-        let mut faces = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
+        let mut faces = Vec::with_capacity(total);
         for (lens, items) in chunks {
             for l in lens {
                 offsets.push(offsets.last().copied().unwrap_or(0) + l);
