@@ -35,7 +35,6 @@
 use super::Grid;
 use crate::geometry::closest_point_triangle;
 use crate::spatial::Bvh;
-use arrayvec::ArrayVec;
 use rayon::prelude::*;
 
 /// Longest list kept; a face with more candidates answers through the BVH.
@@ -54,7 +53,7 @@ const OVERFLOW: u32 = u32::MAX;
 pub(crate) struct ContactLists {
     /// Start of each face's list in `faces` (one more than the faces).
     offsets: Vec<u32>,
-    /// The listed faces, in the BVH's leaf order; `[OVERFLOW]` for a face
+    /// The listed faces, in the range search's order; `[OVERFLOW]` for a face
     /// whose list was too long.
     faces: Vec<u32>,
 }
@@ -66,7 +65,7 @@ impl ContactLists {
         if contact.is_empty() {
             return ContactLists::default();
         }
-        let (bvh, v, t) = (grid.bvh(), grid.vertices(), grid.triangles());
+        let (bvh, t) = (grid.bvh(), grid.triangles());
         let body = &grid.topology().face_body;
         let nodes = grid.node_bodies();
         let gap = grid.contact_gap();
@@ -75,14 +74,8 @@ impl ContactLists {
             for &f in fs {
                 let before = items.len();
                 if contact[f] {
-                    let [a, b, c] = t[f].map(|i| v[i as usize]);
-                    let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
-                    let r = [a, b, c]
-                        .iter()
-                        .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
-                        .fold(0.0, f64::max);
-                    let s = 1e-12 * m.iter().fold(bvh.coord_scale, |x, c| x.max(c.abs()));
-                    let reach = (r + gap) * (1.0 + 1e-9) + 8.0 * s;
+                    let (m, r) = grid.centroid_ball(f);
+                    let reach = (r + gap) * (1.0 + 1e-9) + 8.0 * bvh.rounding_scale(&m);
                     let own = body[f];
                     let full = within(
                         bvh,
@@ -139,9 +132,9 @@ impl ContactLists {
 }
 
 /// Appends to `out` every triangle accepted by `keep` whose computed squared
-/// distance to `p` is at most `r2`, in leaf order, searching nodes whose box
-/// lies within `r2` (padded as the BVH pads) and that `keep_node` accepts.
-/// False (with `out` partly filled) once more than [`MAX_LIST`] were found.
+/// distance to `p` is at most `r2`, in the order [`Bvh::visit_within`] meets
+/// them, below nodes that `keep_node` accepts. False (with `out` partly
+/// filled) once more than [`MAX_LIST`] were found.
 fn within(
     bvh: &Bvh,
     p: [f64; 3],
@@ -150,48 +143,19 @@ fn within(
     keep_node: impl Fn(usize) -> bool,
     out: &mut Vec<u32>,
 ) -> bool {
-    let Some(root) = bvh.nodes.first() else {
-        return true;
-    };
-    let s = 1e-12 * p.iter().fold(bvh.coord_scale, |m, c| m.max(c.abs()));
-    let limit = r2 * (1.0 + 1e-12) + s * (2.0 * r2.sqrt() + s);
-    if root.bbox.distance2(&p) > limit {
-        return true;
-    }
     let start = out.len();
-    let mut stack: ArrayVec<u32, { crate::spatial::MAX_DEPTH + 1 }> = ArrayVec::new();
-    stack.push(0);
-    while let Some(ni) = stack.pop() {
-        let ni = ni as usize;
-        if !keep_node(ni) {
-            continue;
-        }
-        let n = &bvh.nodes[ni];
-        if n.is_leaf() {
-            let s0 = n.start as usize;
-            for slot in s0..s0 + n.count as usize {
-                let u = bvh.prim_triangle[slot];
-                let c = &bvh.prim_corners[slot];
-                if keep(u) && closest_point_triangle(p, c[0], c[1], c[2]).dist2 <= r2 {
-                    if out.len() - start == MAX_LIST {
-                        return false;
-                    }
-                    out.push(u);
-                }
+    let overflowed = bvh.visit_within(p, r2, keep_node, |slot| {
+        let u = bvh.prim_triangle[slot];
+        let c = &bvh.prim_corners[slot];
+        if keep(u) && closest_point_triangle(p, c[0], c[1], c[2]).dist2 <= r2 {
+            if out.len() - start == MAX_LIST {
+                return true;
             }
-            continue;
+            out.push(u);
         }
-        // Right child pushed first so the left is searched first; one net
-        // entry per level keeps the stack within the depth bound.
-        let (l, r) = (ni + 1, n.start as usize);
-        if bvh.nodes[r].bbox.distance2(&p) <= limit {
-            stack.push(r as u32);
-        }
-        if bvh.nodes[l].bbox.distance2(&p) <= limit {
-            stack.push(l as u32);
-        }
-    }
-    true
+        false
+    });
+    !overflowed
 }
 
 #[cfg(test)]

@@ -427,16 +427,10 @@ impl Grid {
                 return Vec::new();
             }
             let gap = self.contact_gap();
-            let v = self.vertices();
             let body = &topo.face_body;
             let nodes = self.node_bodies();
-            let flag = |(f, tri): (usize, &[u32; 3])| {
-                let [a, b, c] = tri.map(|i| v[i as usize]);
-                let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
-                let r = [a, b, c]
-                    .iter()
-                    .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
-                    .fold(0.0, f64::max);
+            let flag = |f: usize| {
+                let (m, r) = self.centroid_ball(f);
                 let own = body[f];
                 self.bvh()
                     .closest_filtered_within_pruned(
@@ -447,12 +441,26 @@ impl Grid {
                     )
                     .is_some()
             };
+            let faces = 0..self.triangles().len();
             if on_rayon_worker() {
-                self.triangles().iter().enumerate().map(flag).collect()
+                faces.map(flag).collect()
             } else {
-                self.triangles().par_iter().enumerate().map(flag).collect()
+                faces.into_par_iter().map(flag).collect()
             }
         })
+    }
+
+    /// Centroid `m` of triangle `f` and its largest distance `r` to a corner:
+    /// every point of the triangle lies within `r` of `m`. O(1).
+    pub(crate) fn centroid_ball(&self, f: usize) -> ([f64; 3], f64) {
+        let v = &self.vertices;
+        let [a, b, c] = self.triangles[f].map(|i| v[i as usize]);
+        let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+        let r = [a, b, c]
+            .iter()
+            .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
+            .fold(0.0, f64::max);
+        (m, r)
     }
 
     /// Per contact face, the other bodies' faces that may lie within the

@@ -175,7 +175,7 @@ impl Grid {
         // box test skips most of the list. `s` bounds the rounding of both
         // distances near `q` (as the BVH's pruning allows), so no face whose
         // computed distance is within the gap is skipped.
-        let s = 1e-12 * q.iter().fold(bvh.coord_scale, |m, c| m.max(c.abs()));
+        let s = bvh.rounding_scale(&q);
         let box_limit = (gap + s) * (gap + s) * (1.0 + 1e-12);
         for &u in list {
             let c = &bvh.prim_corners[bvh.triangle_prim[u as usize] as usize];

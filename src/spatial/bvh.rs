@@ -282,9 +282,6 @@ impl Bvh {
     /// the surface". O(log F) expected when the answer is yes near the hint;
     /// O(log F + k) otherwise, k = triangles whose boxes come within `r`.
     pub fn any_within(&self, p: [f64; 3], r2: f64, hint: Option<u32>) -> Option<u32> {
-        if self.nodes.is_empty() {
-            return None;
-        }
         let test = |slot: usize| {
             let c = &self.prim_corners[slot];
             closest_point_triangle(p, c[0], c[1], c[2]).dist2 <= r2
@@ -294,19 +291,54 @@ impl Bvh {
                 return hint;
             }
         }
+        let mut found = None;
+        self.visit_within(
+            p,
+            r2,
+            |_| true,
+            |slot| {
+                let hit = test(slot);
+                if hit {
+                    found = Some(self.prim_triangle[slot]);
+                }
+                hit
+            },
+        );
+        found
+    }
+
+    /// Visits the primitive slots of every leaf whose box lies within `r2`
+    /// (squared) of `p`, padded for rounding as the searches prune, below
+    /// nodes that `keep_node` accepts, nearer children first, until `visit`
+    /// returns true; true when it did. The range search behind
+    /// [`Bvh::any_within`] and the contact lists. O(log F + k) for k leaves
+    /// within reach.
+    pub fn visit_within(
+        &self,
+        p: [f64; 3],
+        r2: f64,
+        keep_node: impl Fn(usize) -> bool,
+        mut visit: impl FnMut(usize) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
         let limit = padded(r2, self.pad(&p));
         if self.nodes[0].bbox.distance2(&p) > limit {
-            return None;
+            return false;
         }
         let mut stack: ArrayVec<u32, { MAX_DEPTH + 1 }> = ArrayVec::new();
         stack.push(0);
         while let Some(ni) = stack.pop() {
             let ni = ni as usize;
+            if !keep_node(ni) {
+                continue;
+            }
             let n = &self.nodes[ni];
             if n.is_leaf() {
                 let s = n.start as usize;
-                if let Some(slot) = (s..s + n.count as usize).find(|&slot| test(slot)) {
-                    return Some(self.prim_triangle[slot]);
+                if (s..s + n.count as usize).any(&mut visit) {
+                    return true;
                 }
                 continue;
             }
@@ -320,7 +352,15 @@ impl Bvh {
                 stack.push(near as u32);
             }
         }
-        None
+        false
+    }
+
+    /// Scale of the rounding errors of distances near `p`: `1e-12` of the
+    /// largest coordinate magnitude (the root box's or `p`'s). Distances
+    /// computed near `p` err by far less. O(1).
+    #[inline]
+    pub fn rounding_scale(&self, p: &[f64; 3]) -> f64 {
+        1e-12 * p.iter().fold(self.coord_scale, |m, c| m.max(c.abs()))
     }
 
     /// Rounding allowance of squared distances near `p`. Distances computed
@@ -331,7 +371,7 @@ impl Bvh {
     /// the returned `s(2R + s)`.
     #[inline]
     fn pad(&self, p: &[f64; 3]) -> f64 {
-        let s = 1e-12 * p.iter().fold(self.coord_scale, |m, c| m.max(c.abs()));
+        let s = self.rounding_scale(p);
         let b = &self.nodes[0].bbox;
         let mut r2 = 0.0;
         for k in 0..3 {

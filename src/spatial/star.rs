@@ -75,7 +75,7 @@ impl StarMesh<'_> {
     /// largest coordinate magnitude).
     #[inline]
     fn slack(&self, p: &[f64; 3]) -> f64 {
-        1e-12 * p.iter().fold(self.bvh.coord_scale, |m, c| m.max(c.abs()))
+        self.bvh.rounding_scale(p)
     }
 
     /// Faces around vertex `v`.
