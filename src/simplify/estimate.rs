@@ -249,7 +249,10 @@ pub struct FanTri {
 /// `(Δs, Δd)`: the largest ratio of interpolated to target size, either way,
 /// and the largest distance to the target patch, absolute and relative to the
 /// envelope where it lands. Stops as soon as the score reaches `exit_at` (the
-/// values are then lower bounds). O(samples · log F).
+/// values are then lower bounds). The coarse points of every triangle (1 to
+/// 3 each, `i` and `j` multiples of `⌈n/4⌉`) are sampled before the rest, so a failing
+/// collapse stops early; the result of a full pass does not depend on the
+/// order. O(samples · log F).
 pub fn sample_fan(
     target: &Target,
     tris: &[FanTri],
@@ -259,24 +262,93 @@ pub fn sample_fan(
     hint: &mut u32,
 ) -> Sampled {
     let mut out = Sampled::NONE;
-    for t in tris {
-        let full = divisions(&t.p, &t.h);
-        let n = if lim.centroid_only { 3 } else { full };
-        match sample_triangle(target, t, n, h_loc, lim, exit_at, hint, &mut out) {
-            Lattice::Stop => return out,
-            // The light check's centroid lies on two bodies: the contact
-            // tolerance is tight, so the whole lattice is checked there.
-            Lattice::Contact if n < full => {
-                if let Lattice::Stop =
-                    sample_triangle(target, t, full, h_loc, lim, exit_at, hint, &mut out)
-                {
-                    return out;
+    if lim.centroid_only || tris.len() > FAN_MAX {
+        for t in tris {
+            let full = divisions(&t.p, &t.h);
+            let n = if lim.centroid_only { 3 } else { full };
+            match sample_triangle(target, t, n, Part::All, h_loc, lim, exit_at, hint, &mut out) {
+                Lattice::Stop => return out,
+                // The light check's centroid lies on two bodies: the contact
+                // tolerance is tight, so the whole lattice is checked there.
+                Lattice::Contact if n < full => {
+                    if let Lattice::Stop = sample_triangle(
+                        target,
+                        t,
+                        full,
+                        Part::All,
+                        h_loc,
+                        lim,
+                        exit_at,
+                        hint,
+                        &mut out,
+                    ) {
+                        return out;
+                    }
                 }
+                _ => {}
             }
-            _ => {}
+        }
+        return out;
+    }
+    // Coarse points of every triangle first, then the rest: a collapse that
+    // fails usually fails at a coarse point already, and stops there. The
+    // same points are sampled either way, and every term is a maximum, so
+    // a collapsible estimate is the same bits in any order.
+    // Per triangle: the hint its samples left, and whether one lay on two
+    // bodies.
+    let mut state = [(u32::MAX, false); FAN_MAX];
+    for part in [Part::Coarse, Part::Rest] {
+        for (t, st) in tris.iter().zip(state.iter_mut()) {
+            if part == Part::Rest {
+                *hint = st.0;
+            }
+            let n = divisions(&t.p, &t.h);
+            match sample_triangle(target, t, n, part, h_loc, lim, exit_at, hint, &mut out) {
+                Lattice::Stop => return out,
+                lat => *st = (*hint, st.1 || matches!(lat, Lattice::Contact)),
+            }
+            if part == Part::Rest && st.1 && max_angle_deg(t.p) > CAP_ANGLE_DEG {
+                // Where bodies touch, two independent triangulations must
+                // agree at every point, not only at the samples; between
+                // samples they drift apart with each interpolant's gradient,
+                // which a cap makes steep (a size difference over its small
+                // height). Caps stay off contacts.
+                out.refused = Some(Binding::MaxAngle);
+                return out;
+            }
         }
     }
     out
+}
+
+/// Most triangles of one fan sampled coarse points first (a collapse's new
+/// faces; a larger fan is sampled one triangle after the other).
+const FAN_MAX: usize = 64;
+
+/// Which points of a triangle's lattice to sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Part {
+    /// Every interior point.
+    All,
+    /// The points of the coarse sub-lattice: `i`, `j` multiples of
+    /// `⌈n/4⌉` (1 to 3 points, spread over the triangle).
+    Coarse,
+    /// The points not in [`Part::Coarse`].
+    Rest,
+}
+
+impl Part {
+    /// Is lattice point `(i, j)` of `n` divisions in this part?
+    #[inline]
+    fn holds(self, n: usize, i: usize, j: usize) -> bool {
+        let s = n.div_ceil(4);
+        let coarse = i.is_multiple_of(s) && j.is_multiple_of(s);
+        match self {
+            Part::All => true,
+            Part::Coarse => coarse,
+            Part::Rest => !coarse,
+        }
+    }
 }
 
 /// Lattice divisions of a triangle with corners `p` and sizes `h`: samples
@@ -298,14 +370,26 @@ pub fn divisions(p: &[[f64; 3]; 3], h: &[f64; 3]) -> usize {
 /// triangle with corners `p`: each point's barycentric weights and position,
 /// in a fixed order (`(n−1)(n−2)/2` points).
 pub fn lattice(p: &[[f64; 3]; 3], n: usize) -> impl Iterator<Item = ([f64; 3], [f64; 3])> + '_ {
+    lattice_part(p, n, Part::All)
+}
+
+/// The points of [`lattice`] in part `part`, in the same order and with the
+/// same bits.
+fn lattice_part(
+    p: &[[f64; 3]; 3],
+    n: usize,
+    part: Part,
+) -> impl Iterator<Item = ([f64; 3], [f64; 3])> + '_ {
     let inv = 1.0 / n as f64;
     (1..n).flat_map(move |i| {
-        (1..n - i).map(move |j| {
-            let k = n - i - j;
-            let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
-            let q = add(add(scale(p[0], a), scale(p[1], b)), scale(p[2], c));
-            ([a, b, c], q)
-        })
+        (1..n - i)
+            .filter(move |&j| part.holds(n, i, j))
+            .map(move |j| {
+                let k = n - i - j;
+                let (a, b, c) = (i as f64 * inv, j as f64 * inv, k as f64 * inv);
+                let q = add(add(scale(p[0], a), scale(p[1], b)), scale(p[2], c));
+                ([a, b, c], q)
+            })
     })
 }
 
@@ -326,6 +410,7 @@ fn sample_triangle(
     target: &Target,
     t: &FanTri,
     n: usize,
+    part: Part,
     h_loc: f64,
     lim: &Limits,
     exit_at: f64,
@@ -343,7 +428,7 @@ fn sample_triangle(
     } else {
         None
     };
-    for ([a, b, c], p) in lattice(&t.p, n) {
+    for ([a, b, c], p) in lattice_part(&t.p, n, part) {
         let s_data = a * t.h[0] + b * t.h[1] + c * t.h[2];
         let Some(hit) = target.on_patch(p, t.patch, *hint) else {
             *out = Sampled {
@@ -380,11 +465,8 @@ fn sample_triangle(
             return Lattice::Stop;
         }
     }
-    if contact && cap {
-        // Where bodies touch, two independent triangulations must agree at
-        // every point, not only at the samples; between samples they drift
-        // apart with each interpolant's gradient, which a cap makes steep
-        // (a size difference over its small height). Caps stay off contacts.
+    if contact && cap && part == Part::All {
+        // Caps stay off contacts (see `sample_fan`).
         out.refused = Some(Binding::MaxAngle);
         return Lattice::Stop;
     }
@@ -725,5 +807,27 @@ mod tests {
             face_ok(flat, noise, [0.0, 0.0, 1.0], &open),
             Err(Binding::Degenerate)
         );
+    }
+
+    #[test]
+    fn coarse_and_rest_split_the_lattice_point_for_point() {
+        let p = [[0.3, -1.0, 2.0], [1.7, 0.1, 2.5], [-0.4, 0.9, 1.1]];
+        for n in 3..=16 {
+            let all: Vec<_> = lattice(&p, n).collect();
+            let coarse: Vec<_> = lattice_part(&p, n, Part::Coarse).collect();
+            let rest: Vec<_> = lattice_part(&p, n, Part::Rest).collect();
+            // 1 to 3 coarse points from 5 divisions on (the least the
+            // lattice takes), and together the same points, bit for bit.
+            if n >= 5 {
+                assert!((1..=3).contains(&coarse.len()), "n = {n}: {}", coarse.len());
+            }
+            assert_eq!(coarse.len() + rest.len(), all.len(), "n = {n}");
+            let key = |x: &([f64; 3], [f64; 3])| x.1.map(f64::to_bits);
+            let mut split: Vec<_> = coarse.iter().chain(&rest).map(key).collect();
+            let mut whole: Vec<_> = all.iter().map(key).collect();
+            split.sort_unstable();
+            whole.sort_unstable();
+            assert_eq!(split, whole, "n = {n}");
+        }
     }
 }

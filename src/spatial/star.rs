@@ -5,19 +5,24 @@
 //! # The certificate
 //!
 //! For every vertex `v` a *reach* `r_v` is computed once: the distance from
-//! `v` to the nearest triangle that does not contain `v` (∞ when there is
-//! none), less a rounding slack. For a query point `p` at distance `d_v` from
-//! `v`, every triangle `u` outside `v`'s star satisfies
+//! `v` to the nearest triangle that does not contain `v` and carries one of
+//! the labels of `v`'s star, capped at a few times the star's radius
+//! ([`REACH_CAP`]), less a rounding slack.
+//! For a query point `p` at distance `d_v` from `v`, every triangle `u`
+//! outside `v`'s star with such a label satisfies
 //!
 //! ```text
 //! |p − u| ≥ |v − u| − |p − v| ≥ r_v − d_v
 //! ```
 //!
 //! so when the best triangle `B` of the wanted label in the star (distance
-//! `d_B`) has `d_B + d_v < r_v`, every triangle outside the star is strictly
-//! farther than `B`, and `B` is the answer of the whole label, ties included
-//! (ties go to the lowest index, and no tie can lie outside). The reach
-//! ignores labels, so it is a lower bound for every label. The margins cover
+//! `d_B`) has `d_B + d_v < r_v`, every triangle of that label outside the
+//! star is strictly farther than `B`, and `B` is the answer of the whole
+//! label, ties included (ties go to the lowest index, and no tie can lie
+//! outside). A search for a label the star does not hold fails at once, so
+//! the reach needs to bound only the star's own labels: another body lying
+//! on `v` (an assembly's contact) or the far side of a thin wall (another
+//! patch) does not shrink it. The margins cover
 //! rounding: the inequality is tested with a slack of a few
 //! `1e-12 · max |coordinate|` (the BVH's own rounding allowance, far above
 //! the error of an f64 point–triangle distance), so the answer is the BVH's
@@ -50,6 +55,10 @@ use rayon::prelude::*;
 
 /// Most stars a search walks through before it gives up.
 const MAX_STEPS: usize = 4;
+
+/// A vertex's reach is capped at this many times its star's radius (see
+/// [`StarMesh::reaches`]).
+pub const REACH_CAP: f64 = 8.0;
 
 /// What the certified search reads: the vertices and triangles, the faces
 /// around each vertex (compressed rows), a label per triangle and the BVH
@@ -104,18 +113,39 @@ impl StarMesh<'_> {
     }
 
     /// The reach of every vertex (see the module doc): the distance to the
-    /// nearest triangle not containing it, less the rounding slack, ∞ when
-    /// there is none. O(V log F), parallel.
+    /// nearest triangle not containing it whose label is one of its star's,
+    /// capped at [`REACH_CAP`] times the star's radius (its farthest corner),
+    /// less the rounding slack. A capped reach is still a lower bound; it
+    /// leaves to the BVH only points several star radii off the surface
+    /// (which the samples of a simplification and the queries near a grid
+    /// are not), and it keeps the search local where no other triangle of
+    /// the star's labels lies near (a patch that is little more than the
+    /// star), which would otherwise visit the whole tree. O(V log F),
+    /// parallel.
     pub fn reaches(&self) -> Vec<f64> {
         (0..self.vertices.len() as u32)
             .into_par_iter()
             .map(|v| {
                 let x = self.vertices[v as usize];
-                let outside = |u: u32| !self.triangles[u as usize].contains(&v);
-                match self.bvh.closest_filtered(x, None, outside) {
-                    Some(hit) => hit.closest.dist2.sqrt() - 4.0 * self.slack(&x),
-                    None => f64::INFINITY,
-                }
+                let star = self.star(v);
+                let mut labels: Vec<u32> = star.iter().map(|&u| self.labels[u as usize]).collect();
+                labels.sort_unstable();
+                labels.dedup();
+                let radius2 = star
+                    .iter()
+                    .flat_map(|&u| self.triangles[u as usize])
+                    .map(|w| dist2(x, self.vertices[w as usize]))
+                    .fold(0.0, f64::max);
+                let cap = REACH_CAP * radius2.sqrt();
+                let outside = |u: u32| {
+                    !self.triangles[u as usize].contains(&v)
+                        && labels.contains(&self.labels[u as usize])
+                };
+                let reach = match self.bvh.closest_filtered_within(x, cap, outside) {
+                    Some(hit) => hit.closest.dist2.sqrt(),
+                    None => cap,
+                };
+                reach - 4.0 * self.slack(&x)
             })
             .collect()
     }
@@ -297,8 +327,10 @@ mod tests {
 
     #[test]
     fn a_vertex_on_every_triangle_reaches_everywhere() {
-        // Two triangles sharing an edge, each its own label: the edge's ends
-        // lie on every triangle, so any point is certified from them.
+        // Two triangles sharing an edge: the edge's ends lie on every
+        // triangle, so any point is certified from them. The other two
+        // corners reach the far triangle when it carries their label, and
+        // everywhere when it does not.
         let v = vec![
             [0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0],
@@ -306,15 +338,67 @@ mod tests {
             [0.0, 1.0, 0.0],
         ];
         let t = vec![[0, 1, 2], [0, 2, 3]];
+        // Every reach is capped at REACH_CAP star radii (the diagonal for 0
+        // and 2, a side for 1 and 3).
+        let cap = |r: f64| REACH_CAP * r;
+        let s = Surface::new(v.clone(), t.clone(), vec![0, 0]);
+        let reach = s.mesh().reaches();
+        for v in [0, 2] {
+            assert!((reach[v] - cap(2f64.sqrt())).abs() < 1e-9, "{reach:?}");
+        }
+        for v in [1, 3] {
+            assert!((reach[v] - 0.5f64.sqrt()).abs() < 1e-9, "{reach:?}");
+        }
         let s = Surface::new(v, t, vec![0, 1]);
         let mesh = s.mesh();
         let reach = mesh.reaches();
-        assert_eq!([reach[0], reach[2]], [f64::INFINITY; 2]);
-        for v in [1, 3] {
-            assert!((reach[v] - 0.5f64.sqrt()).abs() < 1e-9, "{reach:?}");
+        for (v, r) in reach.iter().enumerate() {
+            let radius = if v % 2 == 0 { 2f64.sqrt() } else { 1.0 };
+            assert!((r - cap(radius)).abs() < 1e-9, "{reach:?}");
         }
         let hit = mesh.closest_near(&reach, [0.0, 1.0, 5.0], 0, 0).unwrap();
         assert_eq!(hit.triangle, 0);
         assert_eq!(hit.closest.point, [0.5, 0.5, 0.0]);
+    }
+
+    #[test]
+    fn another_label_lying_on_the_surface_leaves_the_reach_and_the_answers() {
+        // Two wavy sheets 1e-7 apart, one label each (an assembly's contact):
+        // the reaches ignore the other sheet, points on either are still
+        // certified from their own triangle, and the answers are the BVH's.
+        let (mut v, mut t) = unit_square(12, |x, y| 0.05 * (7.0 * x).sin() * (5.0 * y).cos());
+        let (v2, t2) = unit_square(9, |x, y| 1e-7 + 0.05 * (7.0 * x).sin() * (5.0 * y).cos());
+        let n = v.len() as u32;
+        let mut labels = vec![0; t.len()];
+        v.extend(v2);
+        t.extend(t2.iter().map(|f| f.map(|k| k + n)));
+        labels.resize(t.len(), 1);
+        let s = Surface::new(v, t, labels);
+        let (t, labels, bvh, mesh) = (&s.t, &s.labels, &s.bvh, s.mesh());
+        let reach = mesh.reaches();
+        let lone = Surface::new(
+            s.v[..n as usize].to_vec(),
+            t[..labels.iter().filter(|&&l| l == 0).count()].to_vec(),
+            vec![0; labels.iter().filter(|&&l| l == 0).count()],
+        );
+        assert_eq!(reach[..n as usize], lone.mesh().reaches()[..]);
+        let mut seed = 3u64;
+        let mut certified = 0;
+        for _ in 0..2000 {
+            let tri = (rng(&mut seed) * t.len() as f64) as usize;
+            let c = bvh.prim_corners[bvh.triangle_prim[tri] as usize];
+            let (a, b) = (rng(&mut seed), rng(&mut seed));
+            let (a, b) = (a.min(1.0 - b), b.min(1.0 - a));
+            let p = [0, 1, 2].map(|k| c[0][k] * (1.0 - a - b) + c[1][k] * a + c[2][k] * b);
+            let label = labels[tri];
+            let want = bvh.closest_filtered(p, None, |u| labels[u as usize] == label);
+            if let Ok(got) = mesh.closest_near(&reach, p, label, tri as u32) {
+                certified += 1;
+                let want = want.unwrap();
+                assert_eq!(got.triangle, want.triangle);
+                assert_eq!(got.closest.dist2.to_bits(), want.closest.dist2.to_bits());
+            }
+        }
+        assert!(certified > 1800, "{certified} of 2000");
     }
 }
