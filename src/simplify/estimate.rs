@@ -250,9 +250,9 @@ pub struct FanTri {
 /// and the largest distance to the target patch, absolute and relative to the
 /// envelope where it lands. Stops as soon as the score reaches `exit_at` (the
 /// values are then lower bounds). The coarse points of every triangle (1 to
-/// 3 each, `i` and `j` multiples of `⌈n/4⌉`) are sampled before the rest, so a failing
-/// collapse stops early; the result of a full pass does not depend on the
-/// order. O(samples · log F).
+/// 3 each, `i` and `j` multiples of `⌈n/4⌉`) are sampled before the rest,
+/// so a failing collapse stops early; the result of a full pass does not
+/// depend on the order. O(samples · log F).
 pub fn sample_fan(
     target: &Target,
     tris: &[FanTri],
@@ -293,9 +293,8 @@ pub fn sample_fan(
     // Coarse points of every triangle first, then the rest: a collapse that
     // fails usually fails at a coarse point already, and stops there. The
     // same points are sampled either way, and every term is a maximum, so
-    // a collapsible estimate is the same bits in any order.
-    // Per triangle: the hint its samples left, and whether one lay on two
-    // bodies.
+    // a collapsible estimate is the same bits in any order. Per triangle:
+    // the hint its samples left, and whether one lay on two bodies.
     let mut state = [(u32::MAX, false); FAN_MAX];
     for part in [Part::Coarse, Part::Rest] {
         for (t, st) in tris.iter().zip(state.iter_mut()) {
