@@ -29,3 +29,43 @@ pub(crate) fn unit_square(n: usize, z: impl Fn(f64, f64) -> f64) -> (Vec<[f64; 3
     }
     (v, t)
 }
+
+/// Four open sheets: three meet along the line `y = z = 0`, `0 ≤ x ≤ 1` (a
+/// non-manifold edge line: the first is bent, `z = 0.1·x·y`, the second
+/// stands on the line, the third continues the first into `y < 0`), the
+/// fourth, bent `z = 0.2·x`, lies apart at `x ≥ 3`. Welded, not reoriented.
+pub(crate) fn touching_sheets() -> crate::mesh::Grid {
+    let (mut v, mut t) = unit_square(4, |x, y| 0.1 * x * y);
+    let mut add = |(sv, st): (Vec<[f64; 3]>, Vec<[u32; 3]>), f: &dyn Fn([f64; 3]) -> [f64; 3]| {
+        let o = v.len() as u32;
+        v.extend(sv.into_iter().map(f));
+        t.extend(st.into_iter().map(|x| x.map(|i| i + o)));
+    };
+    add(unit_square(4, |_, _| 0.0), &|p| [p[0], 0.0, p[1]]);
+    add(unit_square(4, |_, _| 0.0), &|p| [p[0], -p[1], 0.0]);
+    add(unit_square(3, |x, _| 0.2 * x), &|p| {
+        [p[0] + 3.0, p[1], p[2]]
+    });
+    let opts = crate::mesh::BuildOptions {
+        weld_relative_tolerance: Some(1e-9),
+        orient: false,
+    };
+    crate::mesh::Grid::from_arrays(v, t, None, &opts).expect("valid sheets")
+}
+
+/// The triangles of `(vertices, triangles)` as corner coordinates' bits,
+/// each rotated to start at its least corner, sorted: equal for two meshes
+/// exactly when they have the same triangles, whatever their order.
+pub(crate) fn canonical_triangles(v: &[[f64; 3]], t: &[[u32; 3]]) -> Vec<[[u64; 3]; 3]> {
+    let mut s: Vec<[[u64; 3]; 3]> = t
+        .iter()
+        .map(|f| {
+            let mut c = f.map(|i| v[i as usize].map(f64::to_bits));
+            let k = (0..3).min_by_key(|&k| c[k]).unwrap_or(0);
+            c.rotate_left(k);
+            c
+        })
+        .collect();
+    s.sort_unstable();
+    s
+}

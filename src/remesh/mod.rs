@@ -18,8 +18,11 @@
 //! inconsistent orientation) is handled without panicking; what could not be
 //! remeshed is listed in [`RemeshReport::issues`].
 //!
-//! Cost: O(F log F) per iteration (projection dominates), parallel (rayon) in
-//! relaxation and projection; the topological passes are sequential. The
+//! Cost: O(F log F) per iteration (projection dominates). Parallel (rayon):
+//! the parts of the mesh (its bodies, once the build has cut touching ones
+//! apart) are remeshed side by side, largest first, and within a part
+//! relaxation and projection run in parallel; a part's topological passes
+//! are sequential, so a single large body gains only from the latter. The
 //! output does not depend on the thread count.
 
 mod field;
@@ -33,6 +36,7 @@ use crate::error::{Error, Result};
 use crate::mesh::halfedge::{BuildReport, HalfedgeMesh, E_LOCKED, V_CORNER, V_FEATURE};
 use crate::mesh::{BuildOptions, Features, Grid};
 use ops::Limits;
+use rayon::prelude::*;
 use reference::Reference;
 use std::time::Instant;
 
@@ -119,7 +123,7 @@ pub struct IterationReport {
     pub vertices: usize,
     /// Faces after the iteration.
     pub faces: usize,
-    /// Seconds spent.
+    /// Seconds spent, summed over the parts (bodies), which run in parallel.
     pub seconds: f64,
 }
 
@@ -186,7 +190,7 @@ pub fn remesh(input: &Grid, params: &RemeshParams) -> Result<Remeshed> {
             "target edge length {l0} must be finite and > 0"
         )));
     }
-    run(input, None, Some(l0), params)
+    run(input, None, Some(l0), params, false)
 }
 
 /// Size-driven remeshing: the target length at a point is the size `sizing`
@@ -199,7 +203,7 @@ pub fn remesh_sized(input: &Grid, sizing: &Grid, params: &RemeshParams) -> Resul
             "the sizing grid has no sizes".into(),
         ));
     }
-    run(input, Some(sizing), None, params)
+    run(input, Some(sizing), None, params, false)
 }
 
 fn check(params: &RemeshParams) -> Result<()> {
@@ -230,6 +234,7 @@ fn run(
     sizing: Option<&Grid>,
     l0: Option<f64>,
     params: &RemeshParams,
+    whole: bool,
 ) -> Result<Remeshed> {
     check(params)?;
     let start = Instant::now();
@@ -325,37 +330,39 @@ fn run(
         build,
         ..Default::default()
     };
-    for _ in 0..params.iterations {
-        let t = Instant::now();
-        let splits = ops::split_long(&mut mesh, &reference, &lim);
-        let collapses = ops::collapse_short(&mut mesh, &lim);
-        let repaired = ops::repair_flat(&mut mesh, &lim, 0.02);
-        let flips = ops::flip_valence(&mut mesh, &lim);
-        // Free the slots the collapses left before relaxing: the first
-        // iteration's splits of long input needles leave several times the
-        // final mesh in slots, and relaxation's per-slot temporaries would
-        // come on top. Compaction keeps the order of what lives and
-        // relaxation is per vertex, so the result is the same.
-        mesh.compact();
-        let mut it = IterationReport {
-            splits,
-            collapses: collapses + repaired,
-            flips,
-            ..Default::default()
-        };
-        for k in 0..params.relax_steps.max(1) {
-            let relax = params.relax_steps > 0 || k > 0;
-            it.cut_moves += smooth::relax_and_project(&mut mesh, &reference, relax, lim.cos_turn);
+    // Bodies are parts of their own (the build cut touching ones apart at
+    // locked copies): each runs its passes on its own thread, largest first.
+    // A part's passes read and write only the part, and it keeps its
+    // elements' relative order (see `HalfedgeMesh::into_parts`), so every
+    // part comes out as it would in the whole mesh, for any thread count.
+    let mesh = if whole {
+        let mut mesh = mesh;
+        let done = iterate(&mut mesh, &reference, &lim, params);
+        report.add(done);
+        mesh
+    } else {
+        let parts = mesh.into_parts();
+        let mut order: Vec<usize> = (0..parts.len()).collect();
+        order.sort_by_key(|&i| std::cmp::Reverse(parts[i].n_faces()));
+        let mut slots: Vec<Option<HalfedgeMesh>> = parts.into_iter().map(Some).collect();
+        let jobs: Vec<(usize, HalfedgeMesh)> = order
+            .iter()
+            .map(|&i| (i, slots[i].take().expect("each part once")))
+            .collect();
+        let done: Vec<(usize, HalfedgeMesh, PartReport)> = jobs
+            .into_par_iter()
+            .with_max_len(1)
+            .map(|(i, mut m)| {
+                let r = iterate(&mut m, &reference, &lim, params);
+                (i, m, r)
+            })
+            .collect();
+        for (i, m, r) in done {
+            slots[i] = Some(m);
+            report.add(r);
         }
-        it.vertices = mesh.vertex_count();
-        it.faces = mesh.face_count();
-        it.seconds = t.elapsed().as_secs_f64();
-        report.iterations.push(it);
-    }
-    report.final_flips = ops::flip_angles(&mut mesh, &lim, 3);
-    report.final_flips += ops::repair_flat(&mut mesh, &lim, 0.02);
-    smooth::relax_and_project(&mut mesh, &reference, false, lim.cos_turn);
-    mesh.compact();
+        HalfedgeMesh::from_parts(slots.into_iter().flatten().collect())
+    };
 
     let sizes: Vec<f64> = mesh
         .vertices()
@@ -397,6 +404,78 @@ fn run(
         feature_edges,
         report,
     })
+}
+
+/// What [`iterate`] did to one part.
+struct PartReport {
+    iterations: Vec<IterationReport>,
+    final_flips: usize,
+}
+
+impl RemeshReport {
+    /// Adds one part's counts (and seconds) to the report.
+    fn add(&mut self, part: PartReport) {
+        if self.iterations.len() < part.iterations.len() {
+            self.iterations
+                .resize(part.iterations.len(), IterationReport::default());
+        }
+        for (sum, it) in self.iterations.iter_mut().zip(part.iterations) {
+            sum.splits += it.splits;
+            sum.collapses += it.collapses;
+            sum.flips += it.flips;
+            sum.cut_moves += it.cut_moves;
+            sum.vertices += it.vertices;
+            sum.faces += it.faces;
+            sum.seconds += it.seconds;
+        }
+        self.final_flips += part.final_flips;
+    }
+}
+
+/// The remeshing iterations and the final clean-up of one mesh (a part, or
+/// everything), compacted at the end. O(F log F) per iteration.
+fn iterate(
+    mesh: &mut HalfedgeMesh,
+    reference: &Reference,
+    lim: &Limits,
+    params: &RemeshParams,
+) -> PartReport {
+    let mut iterations = Vec::with_capacity(params.iterations);
+    for _ in 0..params.iterations {
+        let t = Instant::now();
+        let splits = ops::split_long(mesh, reference, lim);
+        let collapses = ops::collapse_short(mesh, lim);
+        let repaired = ops::repair_flat(mesh, lim, 0.02);
+        let flips = ops::flip_valence(mesh, lim);
+        // Free the slots the collapses left before relaxing: the first
+        // iteration's splits of long input needles leave several times the
+        // final mesh in slots, and relaxation's per-slot temporaries would
+        // come on top. Compaction keeps the order of what lives and
+        // relaxation is per vertex, so the result is the same.
+        mesh.compact();
+        let mut it = IterationReport {
+            splits,
+            collapses: collapses + repaired,
+            flips,
+            ..Default::default()
+        };
+        for k in 0..params.relax_steps.max(1) {
+            let relax = params.relax_steps > 0 || k > 0;
+            it.cut_moves += smooth::relax_and_project(mesh, reference, relax, lim.cos_turn);
+        }
+        it.vertices = mesh.vertex_count();
+        it.faces = mesh.face_count();
+        it.seconds = t.elapsed().as_secs_f64();
+        iterations.push(it);
+    }
+    let mut final_flips = ops::flip_angles(mesh, lim, 3);
+    final_flips += ops::repair_flat(mesh, lim, 0.02);
+    smooth::relax_and_project(mesh, reference, false, lim.cos_turn);
+    mesh.compact();
+    PartReport {
+        iterations,
+        final_flips,
+    }
 }
 
 /// Patches narrower than half their target length (twice the area over the

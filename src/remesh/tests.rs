@@ -1,6 +1,7 @@
 use super::field::{Source, SourceField};
+use super::{run, RemeshParams};
 use crate::geometry::closest_point_triangle;
-use crate::test_shapes::rng;
+use crate::test_shapes::{canonical_triangles, rng, touching_sheets};
 
 #[test]
 fn source_field_equals_brute_force() {
@@ -36,4 +37,61 @@ fn source_field_equals_brute_force() {
         assert_eq!(field.eval(q), brute, "at {q:?}");
     }
     assert_eq!(SourceField::new(&[], slope).eval([0.0; 3]), f64::INFINITY);
+}
+
+/// Remeshing the parts (bodies) apart, in parallel, gives the triangles of
+/// remeshing the whole mesh at once, and the same counts.
+#[test]
+fn parts_remeshed_apart_are_the_whole_remeshed() {
+    let g = touching_sheets();
+    let params = RemeshParams {
+        iterations: 4,
+        ..RemeshParams::default()
+    };
+    let l0 = 0.09;
+    let whole = run(&g, None, Some(l0), &params, true).unwrap();
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let parts = pool.install(|| run(&g, None, Some(l0), &params, false).unwrap());
+        let (a, b) = (&whole.grid, &parts.grid);
+        assert!(a.triangles().len() > 4 * g.triangles().len());
+        assert_eq!(a.vertices().len(), b.vertices().len());
+        assert_eq!(
+            canonical_triangles(a.vertices(), a.triangles()),
+            canonical_triangles(b.vertices(), b.triangles())
+        );
+        let counts = |r: &super::RemeshReport| {
+            r.iterations
+                .iter()
+                .map(|i| {
+                    [
+                        i.splits,
+                        i.collapses,
+                        i.flips,
+                        i.cut_moves,
+                        i.vertices,
+                        i.faces,
+                    ]
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(counts(&whole.report), counts(&parts.report));
+        assert_eq!(whole.report.final_flips, parts.report.final_flips);
+        let key = |g: &crate::mesh::Grid, e: &[[u32; 2]]| {
+            let mut k: Vec<[[u64; 3]; 2]> = e
+                .iter()
+                .map(|x| {
+                    let mut c = x.map(|i| g.vertices()[i as usize].map(f64::to_bits));
+                    c.sort();
+                    c
+                })
+                .collect();
+            k.sort();
+            k
+        };
+        assert_eq!(key(a, &whole.feature_edges), key(b, &parts.feature_edges));
+    }
 }

@@ -30,6 +30,7 @@
 
 mod build;
 mod ops;
+mod parts;
 
 pub use build::BuildReport;
 
@@ -130,7 +131,12 @@ impl HalfedgeMesh {
     /// own size, not the up to 2× of amortised doubling. O(current size)
     /// when an array must move.
     pub fn reserve_splits(&mut self, splits: usize) {
-        let (nv, ne, nf) = (splits, 3 * splits, 2 * splits);
+        self.reserve_exact(splits, 3 * splits, 2 * splits);
+    }
+
+    /// Room for exactly `nv` more vertices, `ne` edges and `nf` faces in
+    /// every array.
+    fn reserve_exact(&mut self, nv: usize, ne: usize, nf: usize) {
         self.positions.reserve_exact(nv);
         self.vout.reserve_exact(nv);
         self.vdel.reserve_exact(nv);
