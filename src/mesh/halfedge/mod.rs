@@ -27,6 +27,9 @@
 //! [`HalfedgeMesh::can_collapse`], the link condition) and [`HalfedgeMesh::flip`]
 //! (checked by [`HalfedgeMesh::is_flip_ok`]) are O(valence); the mesh never
 //! checks geometry or flags: callers decide what may be changed.
+//! [`HalfedgeMesh::into_parts`] and [`HalfedgeMesh::from_parts`] take the
+//! mesh apart into its connected parts (bodies) and put them back, keeping
+//! each part's element order, so parts can be worked on in parallel.
 
 mod build;
 mod ops;
