@@ -14,6 +14,7 @@ use crate::sizing::curvature::patch_curvatures;
 use crate::sizing::normals::PatchNormals;
 use crate::spatial::{Bvh, MAX_DEPTH};
 use arrayvec::ArrayVec;
+use std::cell::Cell;
 use std::f64::consts::PI;
 
 /// Target length across a strip of width w: `STRIP_RATIO · w` (triangles
@@ -260,23 +261,40 @@ impl SourceField {
         if self.bvh.nodes.is_empty() {
             return f64::INFINITY;
         }
-        let mut best = f64::INFINITY;
+        let slots = self.bvh.prim_corners.len();
+        let candidate = |slot: usize| {
+            let [a, b, c] = self.bvh.prim_corners[slot];
+            let i = self.bvh.prim_triangle[slot] as usize;
+            self.value[i] + self.slope * closest_point_triangle(p, a, b, c).dist2.sqrt()
+        };
+        // Seed the bound with the source that won this thread's last query
+        // (queries come in runs of nearby points), so most of the tree is
+        // pruned at once.
+        let seed = LAST_SOURCE.with(Cell::get) as usize;
+        let (mut best, mut best_slot) = if seed < slots {
+            (candidate(seed), seed)
+        } else {
+            (f64::INFINITY, usize::MAX)
+        };
         // Uninitialised storage; one net entry per level, so within capacity.
         let mut stack: ArrayVec<u32, { MAX_DEPTH + 1 }> = ArrayVec::new();
         stack.push(0);
         while let Some(ni) = stack.pop() {
             let ni = ni as usize;
             let n = &self.bvh.nodes[ni];
-            if self.node_min[ni] + self.slope * n.bbox.distance2(&p).sqrt() >= best {
+            if pruned(
+                self.node_min[ni] + self.slope * n.bbox.distance2(&p).sqrt(),
+                best,
+            ) {
                 continue;
             }
             if n.is_leaf() {
                 let s = n.start as usize;
                 for slot in s..s + n.count as usize {
-                    let [a, b, c] = self.bvh.prim_corners[slot];
-                    let i = self.bvh.prim_triangle[slot] as usize;
-                    let d = closest_point_triangle(p, a, b, c).dist2.sqrt();
-                    best = best.min(self.value[i] + self.slope * d);
+                    let c = candidate(slot);
+                    if c < best {
+                        (best, best_slot) = (c, slot);
+                    }
                 }
             } else {
                 let (l, r) = (ni + 1, n.start as usize);
@@ -290,6 +308,28 @@ impl SourceField {
                 stack.push(first as u32);
             }
         }
+        if best_slot < slots {
+            LAST_SOURCE.with(|x| x.set(best_slot as u32));
+        }
         best
     }
+}
+
+thread_local! {
+    /// The source slot that gave this thread's last [`SourceField::eval`]
+    /// value: only a first bound, checked against the field's size, so a
+    /// slot of another field or a stale one costs a little pruning, never a
+    /// wrong value.
+    static LAST_SOURCE: Cell<u32> = const { Cell::new(u32::MAX) };
+}
+
+/// May a node whose lower bound is `bound` be skipped when the best value so
+/// far is `best`? Only when the bound exceeds it by more than rounding: a
+/// node's bound (its least value plus the slope times its box distance) can
+/// exceed the value of a source inside by a few units in the last place
+/// only, so the least value is never pruned, whatever bound the search
+/// started from, and the result is the same for any seed (and any thread).
+#[inline(always)]
+fn pruned(bound: f64, best: f64) -> bool {
+    bound > best * (1.0 + 1e-12)
 }

@@ -35,6 +35,10 @@ fn source_field_equals_brute_force() {
             .map(|(t, h)| h + slope * closest_point_triangle(q, t[0], t[1], t[2]).dist2.sqrt())
             .fold(f64::INFINITY, f64::min);
         assert_eq!(field.eval(q), brute, "at {q:?}");
+        // Seeded by this query's own winner, then by a far point's.
+        assert_eq!(field.eval(q), brute, "at {q:?}, seeded");
+        field.eval([1e3, -1e3, 1e3]);
+        assert_eq!(field.eval(q), brute, "at {q:?}, seeded far away");
     }
     assert_eq!(SourceField::new(&[], slope).eval([0.0; 3]), f64::INFINITY);
 }
