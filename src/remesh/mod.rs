@@ -234,6 +234,7 @@ fn run(
     sizing: Option<&Grid>,
     l0: Option<f64>,
     params: &RemeshParams,
+    // Remesh the mesh as one, not part by part (the tests' reference).
     whole: bool,
 ) -> Result<Remeshed> {
     check(params)?;
@@ -341,15 +342,10 @@ fn run(
         report.add(done);
         mesh
     } else {
-        let parts = mesh.into_parts();
-        let mut order: Vec<usize> = (0..parts.len()).collect();
-        order.sort_by_key(|&i| std::cmp::Reverse(parts[i].n_faces()));
-        let mut slots: Vec<Option<HalfedgeMesh>> = parts.into_iter().map(Some).collect();
-        let jobs: Vec<(usize, HalfedgeMesh)> = order
-            .iter()
-            .map(|&i| (i, slots[i].take().expect("each part once")))
-            .collect();
-        let done: Vec<(usize, HalfedgeMesh, PartReport)> = jobs
+        let mut jobs: Vec<(usize, HalfedgeMesh)> =
+            mesh.into_parts().into_iter().enumerate().collect();
+        jobs.sort_by_key(|(i, m)| (std::cmp::Reverse(m.n_faces()), *i));
+        let mut done: Vec<(usize, HalfedgeMesh, PartReport)> = jobs
             .into_par_iter()
             .with_max_len(1)
             .map(|(i, mut m)| {
@@ -357,11 +353,13 @@ fn run(
                 (i, m, r)
             })
             .collect();
-        for (i, m, r) in done {
-            slots[i] = Some(m);
+        done.sort_unstable_by_key(|x| x.0);
+        let mut parts = Vec::with_capacity(done.len());
+        for (_, m, r) in done {
+            parts.push(m);
             report.add(r);
         }
-        HalfedgeMesh::from_parts(slots.into_iter().flatten().collect())
+        HalfedgeMesh::from_parts(parts)
     };
 
     let sizes: Vec<f64> = mesh

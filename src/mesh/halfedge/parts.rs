@@ -43,18 +43,14 @@ impl HalfedgeMesh {
     pub fn into_parts(self) -> Vec<HalfedgeMesh> {
         let nv = self.n_vertices();
         let mut parent: Vec<u32> = (0..nv as u32).collect();
+        let mut on_edge = vec![false; nv];
         for e in self.edges() {
             let [a, b] = self.edge_vertices(e);
+            (on_edge[a as usize], on_edge[b as usize]) = (true, true);
             let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
             // The lower index becomes the root, so a root is its part's lowest vertex.
             if ra != rb {
                 parent[ra.max(rb) as usize] = ra.min(rb);
-            }
-        }
-        let mut on_edge = vec![false; nv];
-        for e in self.edges() {
-            for v in self.edge_vertices(e) {
-                on_edge[v as usize] = true;
             }
         }
         // Part of each vertex root, numbered in order of the lowest vertex.
