@@ -329,8 +329,9 @@ fn batched_selection_estimates_less_for_an_equal_grid() {
             it.iter().map(|r| r.estimated).sum()
         }
     };
-    // The pool is 3,072 edges in 6 batches: the first batch is estimated
-    // whole, the later ones only where no collapse was claimed yet.
+    // The pool is 3,072 edges in 96 batches of 32: the first batch is
+    // estimated whole, the later ones only where no collapse was claimed
+    // yet.
     assert!(
         estimated(&batched, true) * 2 < estimated(&global, true),
         "first iteration: {} vs {}",

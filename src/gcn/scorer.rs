@@ -215,7 +215,7 @@ impl Learned<'_> {
                 continue;
             }
             let made = self.refused[e as usize];
-            if made != 0 && view.stamps.unchanged(mesh, e, made, &mut self.ring) {
+            if made != 0 && view.stamps.unchanged(mesh, e, made) {
                 continue;
             }
             order.push((ye, e));

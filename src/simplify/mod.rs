@@ -29,12 +29,18 @@
 //! its neighbourhood changes. The result is what re-estimating every
 //! candidate every iteration would give, without the cost.
 //!
+//! The bodies of an assembly (the mesh's connected parts) run their
+//! iterations side by side, each with its own ranking and budget
+//! (`simplify::iterate`).
+//!
 //! Deterministic: estimates are computed in parallel but applied in a fixed
-//! order, so the output bits do not depend on the thread count.
+//! order, and each part runs as it would alone, so the output bits do not
+//! depend on the thread count.
 
 pub mod envelope;
 pub mod estimate;
 pub mod fit;
+mod iterate;
 mod repair;
 pub mod scorer;
 pub mod select;
@@ -113,7 +119,8 @@ pub enum Method {
 /// (see [`scorer::Accurate`] for each one's cost).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Selection {
-    /// The pool in LBO order, in batches of [`scorer::BATCH`] edges: an
+    /// The pool in LBO order, in batches of [`scorer::batch_size`] edges
+    /// (a 1024th of the pool, 32 to 512): an
     /// edge whose closed 1-ring meets a collapse already chosen this
     /// iteration is skipped without being estimated, the others are
     /// estimated in parallel, and the batch's collapsible ones are taken by
@@ -556,14 +563,13 @@ pub(crate) fn run_loop(
     grid: &Grid,
     params: &SimplifyParams,
     scorer: &mut dyn EdgeScorer,
-    mut progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
-    mut observer: Option<Observer>,
+    progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
+    observer: Option<Observer>,
 ) -> Result<Simplified> {
     let start = Instant::now();
-    let (mut mesh, parts) = setup(grid, params)?;
+    let (mesh, parts) = setup(grid, params)?;
     let target = parts.target(grid);
     let lim = params.limits();
-    let cos_crease = repair::crease_limit(params.feature_angle_deg);
     let mut report = SimplifyReport {
         faces_in: grid.triangles().len(),
         vertices_in: grid.vertices().len(),
@@ -573,114 +579,18 @@ pub(crate) fn run_loop(
             .filter(|&v| mesh.vertex_flags[v as usize] & V_CORNER != 0)
             .count(),
         element_count_in: own_element_count(&mesh),
-        stop: StopReason::MaxIterations,
         ..Default::default()
     };
-    let mut stamps = Stamps::new(mesh.n_vertices());
-    let mut used = vec![false; mesh.n_vertices()];
-    for it in 1..=params.max_iterations as u32 {
-        let t = Instant::now();
-        let live = mesh.edge_count();
-        let view = View {
-            mesh: &mesh,
-            target: &target,
-            lim: &lim,
-            params,
-            stamps: &stamps,
-            iteration: it,
-            last: false,
-        };
-        if let Some(obs) = observer.as_mut() {
-            obs(&view)?;
-        }
-        // An empty ranking that is not exhausted means every edge of this
-        // pool was found not collapsible: rank again, further on (those are
-        // now known), within the same iteration.
-        let mut ranking = scorer.rank(&view)?;
-        while ranking.ranked.is_empty() && !ranking.exhausted {
-            let more = scorer.rank(&view)?;
-            ranking = Ranking {
-                candidates: ranking.candidates + more.candidates,
-                estimated: ranking.estimated + more.estimated,
-                ..more
-            };
-        }
-        let ranked_edges: Vec<u32> = ranking.ranked.iter().map(|x| x.0).collect();
-        let limit = ((params.fraction * live as f64).floor() as usize).max(1);
-        let chosen = select::disjoint_rings(&mesh, &ranked_edges, limit, &mut used);
-        let mut rec = IterationRecord {
-            iteration: it as usize,
-            candidates: ranking.candidates,
-            estimated: ranking.estimated,
-            collapsible: ranking.ranked.len(),
-            ..Default::default()
-        };
-        let by_edge: std::collections::HashMap<u32, Estimate> =
-            ranking.ranked.iter().copied().collect();
-        let mut kept = Vec::with_capacity(chosen.len());
-        for e in &chosen {
-            let Some(&est) = by_edge.get(e) else {
-                continue;
-            };
-            let w = mesh.to_vertex(est.halfedge);
-            let moved = est.position != mesh.positions[w as usize];
-            if mesh.collapse(est.halfedge, est.position).is_err() {
-                continue;
-            }
-            mesh.vertex_size[w as usize] = est.size;
-            if est.hint != NONE {
-                mesh.vertex_hint[w as usize] = est.hint;
-            }
-            if moved {
-                stamps.moved[w as usize] = it;
-            }
-            stamps.ring[w as usize] = it;
-            for u in mesh.neighbors(w) {
-                stamps.ring[u as usize] = it;
-            }
-            kept.push(w);
-            rec.accepted += 1;
-        }
-        if params.repair && !kept.is_empty() {
-            let moved = repair::relax(&mut mesh, &target, &kept, &lim);
-            rec.moved = moved.len();
-            for &v in &moved {
-                stamps.moved[v as usize] = it;
-            }
-            let flipped = repair::flip_around(&mut mesh, &target, &kept, &lim, cos_crease);
-            rec.flips = flipped.len() / 4;
-            for v in flipped {
-                stamps.ring[v as usize] = it;
-            }
-        }
-        rec.faces = mesh.face_count();
-        rec.vertices = mesh.vertex_count();
-        rec.element_count = own_element_count(&mesh);
-        rec.seconds = t.elapsed().as_secs_f64();
-        report.iterations.push(rec);
-        if rec.accepted == 0 {
-            report.stop = StopReason::Converged;
-            break;
-        }
-        if let Some(cb) = progress.as_mut() {
-            if !cb(&rec) {
-                report.stop = StopReason::Cancelled;
-                break;
-            }
-        }
-    }
-    if let Some(obs) = observer.as_mut() {
-        let last = report.iterations.len() as u32 + 1;
-        obs(&View {
-            mesh: &mesh,
-            target: &target,
-            lim: &lim,
-            params,
-            stamps: &stamps,
-            iteration: last,
-            last: true,
-        })?;
-    }
+    let cx = iterate::Context {
+        target: &target,
+        lim: &lim,
+        params,
+        cos_crease: repair::crease_limit(params.feature_angle_deg),
+    };
+    let looped = iterate::run(mesh, scorer, &cx, progress, observer)?;
+    report.iterations = looped.iterations;
+    report.stop = looped.stop;
+    let mut mesh = looped.piece.mesh;
     if params.fit_sizes {
         let t = Instant::now();
         report.fit = fit::fit_sizes(&mut mesh, &target, lim.t_size);

@@ -79,15 +79,30 @@ pub trait EdgeScorer {
     /// Ranks the edges of `view.mesh` for this iteration. Errors only when
     /// the scorer itself fails (e.g. a model that cannot be run).
     fn rank(&mut self, view: &View) -> Result<Ranking>;
+
+    /// A fresh scorer of the same kind for one part of the mesh (a body cut
+    /// apart from the others; the loop's module `simplify::iterate`), when
+    /// this scorer ranks a part on its own terms: the loop then simplifies
+    /// the parts side by side, each with its own. `None` (the default) when
+    /// its ranking needs the whole mesh at once (a graph network's forward
+    /// pass over the whole graph): the loop then runs on the whole mesh
+    /// with this scorer.
+    fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send>> {
+        None
+    }
 }
 
-/// When each vertex last changed: `moved` (position or size) and `ring`
-/// (its set of neighbours), as iteration numbers (0 = never).
+/// When each vertex last changed: `moved` (position or size), `ring` (its
+/// set of neighbours) and `moved_near` (it or a neighbour moved), as
+/// iteration numbers (0 = never).
 pub struct Stamps {
     /// Last iteration that moved the vertex or changed its size.
     pub moved: Vec<u32>,
     /// Last iteration that changed its neighbours.
     pub ring: Vec<u32>,
+    /// Last iteration that moved the vertex or one of its neighbours of the
+    /// time (set by [`Stamps::mark_moved`]).
+    pub moved_near: Vec<u32>,
 }
 
 impl Stamps {
@@ -96,13 +111,27 @@ impl Stamps {
         Stamps {
             moved: vec![0; n],
             ring: vec![0; n],
+            moved_near: vec![0; n],
+        }
+    }
+
+    /// Vertex `v` moved (or its size changed) at iteration `it`: stamps it
+    /// and, in `moved_near`, it and its neighbours. O(valence).
+    pub fn mark_moved(&mut self, mesh: &HalfedgeMesh, v: u32, it: u32) {
+        self.moved[v as usize] = it;
+        self.moved_near[v as usize] = it;
+        for u in mesh.neighbors(v) {
+            self.moved_near[u as usize] = it;
         }
     }
 
     /// Is an estimate of edge `e` made at iteration `made` still exact? It
     /// reads the faces around the two ends (their rings, and the positions
     /// and sizes of every vertex there) and the valence of the two apexes.
-    pub fn unchanged(&self, mesh: &HalfedgeMesh, e: u32, made: u32, ring: &mut Vec<u32>) -> bool {
+    /// O(1): when neither end's ring changed since `made`, its neighbours
+    /// are those it had at every move since, so a move anywhere in the
+    /// closed ring of `e` stamped `moved_near` of an end.
+    pub fn unchanged(&self, mesh: &HalfedgeMesh, e: u32, made: u32) -> bool {
         let [a, b] = mesh.edge_vertices(e);
         if self.ring[a as usize] >= made || self.ring[b as usize] >= made {
             return false;
@@ -114,8 +143,7 @@ impl Stamps {
                 return false;
             }
         }
-        select::closed_ring(mesh, e, ring);
-        ring.iter().all(|&v| self.moved[v as usize] < made)
+        self.moved_near[a as usize] < made && self.moved_near[b as usize] < made
     }
 }
 
@@ -133,26 +161,42 @@ impl Stamps {
 /// iteration: about 20 estimates per collapse.
 ///
 /// With [`Selection::Batched`] (the default) the pool is walked in LBO order
-/// in batches of [`BATCH`] edges; an edge whose closed 1-ring meets one
+/// in batches of [`batch_size`] edges; an edge whose closed 1-ring meets one
 /// already claimed this iteration is skipped unestimated, the rest of the
 /// batch is estimated in parallel, and its collapsible edges claim their
 /// rings lowest score first. Estimates are then spent on edges that can
 /// still be chosen; occt_crankarm's first iteration estimates 1,394 edges
 /// for 940 collapses, against 17,396 for 966. The choice differs from the
 /// global one only in which of two overlapping collapses goes first (LBO
-/// order between batches, the score within one).
+/// order between batches, the score within one). The claims mark the
+/// claimed rings and their neighbours, so whether an edge's ring is free is
+/// two reads (its ends), not a walk around its ring.
 #[derive(Debug, Default)]
 pub struct Accurate {
     cache: Vec<Option<(u32, Estimate)>>,
-    ring: Vec<u32>,
 }
 
-/// Edges of the pool handled per batch by [`Selection::Batched`]: enough
-/// parallel work for any thread count (a batch's estimates take tens of
-/// milliseconds on the big shared models), few against a pool of thousands, so that little is
-/// estimated before the claims of the batches ahead of it. A constant, so
-/// the choice does not depend on the thread count.
+/// Most edges of the pool handled per batch by [`Selection::Batched`]:
+/// enough parallel work for any thread count (a batch's estimates take tens
+/// of milliseconds on the big shared models), few against a large pool, so
+/// that little is estimated before the claims of the batches ahead of it.
 pub const BATCH: usize = 512;
+
+/// Fewest edges per batch (see [`batch_size`]).
+pub const MIN_BATCH: usize = 32;
+
+/// Edges per batch for a pool of `pool_size` edges: a 1024th of the pool,
+/// within [`MIN_BATCH`]..=[`BATCH`]. A batch's edges are all estimated
+/// before any of them claims its ring, and the pool's edges lie close
+/// together (the smoothest fifth of a part), so a batch that is a large
+/// share of the pool estimates many edges that its own claims then block.
+/// trimesh_fm1_satellite's simplification made 5.90 M estimates with 512
+/// always, 4.55 M with a 64th and 4.29 M with a 1024th of the pool. A
+/// function of the pool alone, so the choice does not depend on the thread
+/// count.
+pub fn batch_size(pool_size: usize) -> usize {
+    (pool_size / 1024).clamp(MIN_BATCH, BATCH)
+}
 
 /// Lowest score first, ties by edge index.
 fn by_score(a: &(u32, Estimate), b: &(u32, Estimate)) -> std::cmp::Ordering {
@@ -190,19 +234,22 @@ impl Accurate {
     /// O(Σ ring sizes + estimates).
     fn rank_batched(&mut self, view: &View, pool: &[(u32, bool)], pool_size: usize) -> Ranking {
         let mesh = view.mesh;
-        let mut claimed = vec![false; mesh.n_vertices()];
+        // The claimed rings and every neighbour of them: the closed ring of
+        // an edge meets a claimed ring exactly when one of its two ends is
+        // in here (adjacency is symmetric), so a check is two reads.
+        let mut blocked = vec![false; mesh.n_vertices()];
         let mut ranked: Vec<(u32, Estimate)> = Vec::new();
         let mut estimated = 0;
         let mut ring = Vec::new();
-        let free = |e: u32, ring: &mut Vec<u32>, claimed: &[bool]| {
-            select::closed_ring(mesh, e, ring);
-            !ring.iter().any(|&v| claimed[v as usize])
+        let free = |e: u32, blocked: &[bool]| {
+            let [a, b] = mesh.edge_vertices(e);
+            !blocked[a as usize] && !blocked[b as usize]
         };
-        for batch in pool.chunks(BATCH) {
+        for batch in pool.chunks(batch_size(pool_size)) {
             let mut open = Vec::with_capacity(batch.len());
             let mut fresh = Vec::new();
             for &(e, stale) in batch {
-                if free(e, &mut ring, &claimed) {
+                if free(e, &blocked) {
                     open.push(e);
                     if stale {
                         fresh.push(e);
@@ -212,9 +259,13 @@ impl Accurate {
             self.estimate_afresh(view, &fresh);
             estimated += fresh.len();
             for (e, est) in self.collapsible(open.iter().copied()) {
-                if free(e, &mut ring, &claimed) {
+                if free(e, &blocked) {
+                    select::closed_ring(mesh, e, &mut ring);
                     for &v in &ring {
-                        claimed[v as usize] = true;
+                        blocked[v as usize] = true;
+                        for u in mesh.neighbors(v) {
+                            blocked[u as usize] = true;
+                        }
                     }
                     ranked.push((e, est));
                 }
@@ -231,6 +282,11 @@ impl Accurate {
 }
 
 impl EdgeScorer for Accurate {
+    /// LBO-ABGS ranks each part by its own LBO order and budget.
+    fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send>> {
+        Some(Box::new(Accurate::default()))
+    }
+
     fn rank(&mut self, view: &View) -> Result<Ranking> {
         let mesh = view.mesh;
         if self.cache.len() < mesh.n_edges() {
@@ -238,21 +294,24 @@ impl EdgeScorer for Accurate {
         }
         let live = mesh.edge_count();
         let lbo = select::edge_lbo(mesh);
-        let mut order: Vec<u32> = mesh
+        // Keys beside the edges: the sort reads them in place (a total
+        // order, ties by edge index, so an unstable sort gives the one order).
+        let mut order: Vec<(f64, u32)> = mesh
             .edges()
             .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED == 0)
+            .map(|e| (lbo[e as usize], e))
             .collect();
-        order.sort_by(|&a, &b| lbo[a as usize].total_cmp(&lbo[b as usize]).then(a.cmp(&b)));
+        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let p = view.params;
         let pool_size = (p.pool_factor * p.fraction * live as f64).ceil() as usize;
         // The pool, each edge with whether its estimate must be made afresh.
         let mut pool = Vec::with_capacity(pool_size);
-        for e in order {
+        for (_, e) in order {
             if pool.len() >= pool_size {
                 break;
             }
-            let known = self.cache[e as usize]
-                .filter(|(made, _)| view.stamps.unchanged(mesh, e, *made, &mut self.ring));
+            let known =
+                self.cache[e as usize].filter(|(made, _)| view.stamps.unchanged(mesh, e, *made));
             match known {
                 Some((_, est)) if !est.collapsible() => continue,
                 Some(_) => pool.push((e, false)),
