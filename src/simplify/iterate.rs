@@ -28,7 +28,8 @@
 //! What this changes against one loop over the whole mesh: the LBO ranking
 //! and the `n·|E|` budget are per body, so a body is not kept waiting for
 //! the smoother bodies of the assembly to run out of candidates. A mesh of
-//! one part is simplified exactly as before.
+//! one part is simplified exactly as one loop over it would (`cmp` on
+//! cgal_fandisk and forgescan_abc8).
 //!
 //! Why it pays: within a part the estimates are parallel but the ranking,
 //! the claims, the collapses and the flips are sequential, about 40 % of
@@ -64,15 +65,13 @@ pub(super) struct Context<'a> {
 
 /// One mesh the loop simplifies (a part, or everything) with its state
 /// between iterations.
-pub(super) struct Piece {
+struct Piece {
     /// Its place among the parts.
     index: usize,
     /// The mesh.
-    pub mesh: HalfedgeMesh,
-    /// The part's own scorer (`None`: the caller's scorer, whole mesh).
-    scorer: Option<Box<dyn EdgeScorer + Send>>,
+    mesh: HalfedgeMesh,
     /// When each vertex last changed.
-    pub stamps: Stamps,
+    stamps: Stamps,
     /// One flag per vertex for the ring filter (all false between calls).
     used: Vec<bool>,
     /// A past iteration collapsed nothing.
@@ -84,16 +83,28 @@ pub(super) struct Piece {
 
 impl Piece {
     /// `mesh` with fresh state.
-    fn new(index: usize, mesh: HalfedgeMesh, scorer: Option<Box<dyn EdgeScorer + Send>>) -> Piece {
+    fn new(index: usize, mesh: HalfedgeMesh) -> Piece {
         let n = mesh.n_vertices();
         Piece {
             index,
             mesh,
-            scorer,
             stamps: Stamps::new(n),
             used: vec![false; n],
             done: false,
             last: IterationRecord::default(),
+        }
+    }
+
+    /// What an observer sees of this piece at iteration `it`.
+    fn view<'a>(&'a self, cx: &'a Context, it: u32, last: bool) -> View<'a> {
+        View {
+            mesh: &self.mesh,
+            target: cx.target,
+            lim: cx.lim,
+            params: cx.params,
+            stamps: &self.stamps,
+            iteration: it,
+            last,
         }
     }
 }
@@ -188,7 +199,7 @@ fn step(
 /// What the loop did.
 pub(super) struct Looped {
     /// The simplified mesh (parts put back together).
-    pub piece: Piece,
+    pub mesh: HalfedgeMesh,
     /// One record per iteration.
     pub iterations: Vec<IterationRecord>,
     /// Why it stopped.
@@ -198,7 +209,8 @@ pub(super) struct Looped {
 /// Runs the iterations on `mesh`: part by part side by side when `scorer`
 /// offers a scorer per part and there is no observer, else as one mesh with
 /// `scorer` itself (see the module doc). `observer` sees the whole mesh
-/// before each iteration's ranking; its error stops the loop.
+/// before each iteration's ranking and once more at the end; its error
+/// stops the loop.
 pub(super) fn run(
     mesh: HalfedgeMesh,
     scorer: &mut dyn EdgeScorer,
@@ -206,18 +218,22 @@ pub(super) fn run(
     mut progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
     mut observer: Option<super::Observer>,
 ) -> Result<Looped> {
+    // One scorer per part, beside the parts (empty: the whole mesh with
+    // `scorer`).
+    let mut scorers: Vec<Box<dyn EdgeScorer + Send>> = Vec::new();
     let by_parts = observer.is_none() && scorer.for_part().is_some();
     let mut pieces: Vec<Piece> = if by_parts {
         let mut p: Vec<Piece> = mesh
             .into_parts()
             .into_iter()
             .enumerate()
-            .map(|(i, m)| Piece::new(i, m, scorer.for_part()))
+            .map(|(i, m)| Piece::new(i, m))
             .collect();
         p.sort_by_key(|x| (std::cmp::Reverse(x.mesh.n_faces()), x.index));
+        scorers.extend(p.iter().filter_map(|_| scorer.for_part()));
         p
     } else {
-        vec![Piece::new(0, mesh, None)]
+        vec![Piece::new(0, mesh)]
     };
     let mut iterations = Vec::new();
     let mut stop = StopReason::MaxIterations;
@@ -230,14 +246,10 @@ pub(super) fn run(
         if by_parts {
             let done: Vec<IterationRecord> = pieces
                 .par_iter_mut()
+                .zip(scorers.par_iter_mut())
                 .with_max_len(1)
-                .filter(|p| !p.done)
-                .map(|p| {
-                    let Some(s) = p.scorer.as_mut() else {
-                        // Not reached: every part has a scorer of its own.
-                        p.done = true;
-                        return Ok(IterationRecord::default());
-                    };
+                .filter(|(p, _)| !p.done)
+                .map(|(p, s)| {
                     let r = step(&mut p.mesh, &mut **s, &mut p.stamps, &mut p.used, cx, it)?;
                     p.done = r.accepted == 0;
                     p.last = r;
@@ -260,15 +272,7 @@ pub(super) fn run(
         } else {
             let p = &mut pieces[0];
             if let Some(obs) = observer.as_mut() {
-                obs(&View {
-                    mesh: &p.mesh,
-                    target: cx.target,
-                    lim: cx.lim,
-                    params: cx.params,
-                    stamps: &p.stamps,
-                    iteration: it,
-                    last: false,
-                })?;
+                obs(&p.view(cx, it, false))?;
             }
             rec = step(&mut p.mesh, scorer, &mut p.stamps, &mut p.used, cx, it)?;
         }
@@ -285,30 +289,18 @@ pub(super) fn run(
             }
         }
     }
-    let piece = if by_parts {
-        pieces.sort_unstable_by_key(|p| p.index);
-        let mesh = HalfedgeMesh::from_parts(pieces.into_iter().map(|p| p.mesh).collect());
-        Piece::new(0, mesh, None)
-    } else {
-        // The one piece (an empty mesh should there be none).
-        pieces
-            .pop()
-            .unwrap_or_else(|| Piece::new(0, HalfedgeMesh::new(), None))
-    };
-    if let Some(obs) = observer.as_mut() {
-        let last = iterations.len() as u32 + 1;
-        obs(&View {
-            mesh: &piece.mesh,
-            target: cx.target,
-            lim: cx.lim,
-            params: cx.params,
-            stamps: &piece.stamps,
-            iteration: last,
-            last: true,
-        })?;
+    pieces.sort_unstable_by_key(|p| p.index);
+    if let (Some(obs), [p]) = (observer.as_mut(), pieces.as_slice()) {
+        obs(&p.view(cx, iterations.len() as u32 + 1, true))?;
     }
+    let mut meshes: Vec<HalfedgeMesh> = pieces.into_iter().map(|p| p.mesh).collect();
+    let mesh = match meshes.len() {
+        // One piece is the mesh itself: no copy.
+        1 => meshes.pop().unwrap_or_default(),
+        _ => HalfedgeMesh::from_parts(meshes),
+    };
     Ok(Looped {
-        piece,
+        mesh,
         iterations,
         stop,
     })

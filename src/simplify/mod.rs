@@ -590,7 +590,7 @@ pub(crate) fn run_loop(
     let looped = iterate::run(mesh, scorer, &cx, progress, observer)?;
     report.iterations = looped.iterations;
     report.stop = looped.stop;
-    let mut mesh = looped.piece.mesh;
+    let mut mesh = looped.mesh;
     if params.fit_sizes {
         let t = Instant::now();
         report.fit = fit::fit_sizes(&mut mesh, &target, lim.t_size);

@@ -86,22 +86,21 @@ pub trait EdgeScorer {
     /// the parts side by side, each with its own. `None` (the default) when
     /// its ranking needs the whole mesh at once (a graph network's forward
     /// pass over the whole graph): the loop then runs on the whole mesh
-    /// with this scorer.
+    /// with this scorer. Every call must answer alike (all `Some` or all
+    /// `None`): the loop asks once per part.
     fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send>> {
         None
     }
 }
 
-/// When each vertex last changed: `moved` (position or size), `ring` (its
-/// set of neighbours) and `moved_near` (it or a neighbour moved), as
-/// iteration numbers (0 = never).
+/// When each vertex last changed, as iteration numbers (0 = never): `ring`
+/// (its set of neighbours) and `moved_near` (its or a neighbour's position
+/// or size).
 pub struct Stamps {
-    /// Last iteration that moved the vertex or changed its size.
-    pub moved: Vec<u32>,
     /// Last iteration that changed its neighbours.
     pub ring: Vec<u32>,
     /// Last iteration that moved the vertex or one of its neighbours of the
-    /// time (set by [`Stamps::mark_moved`]).
+    /// time, or changed their size (set by [`Stamps::mark_moved`]).
     pub moved_near: Vec<u32>,
 }
 
@@ -109,16 +108,14 @@ impl Stamps {
     /// No vertex of an `n`-vertex mesh changed yet.
     pub fn new(n: usize) -> Stamps {
         Stamps {
-            moved: vec![0; n],
             ring: vec![0; n],
             moved_near: vec![0; n],
         }
     }
 
     /// Vertex `v` moved (or its size changed) at iteration `it`: stamps it
-    /// and, in `moved_near`, it and its neighbours. O(valence).
+    /// and its neighbours in `moved_near`. O(valence).
     pub fn mark_moved(&mut self, mesh: &HalfedgeMesh, v: u32, it: u32) {
-        self.moved[v as usize] = it;
         self.moved_near[v as usize] = it;
         for u in mesh.neighbors(v) {
             self.moved_near[u as usize] = it;
