@@ -108,9 +108,26 @@ pub fn run(path: &Path, n: usize, secs: f64, as_json: bool) -> Result<()> {
                         .sum()
                 })
             });
-            let agree = (plain.1 - hinted.1).abs() <= 1e-9 * plain.1.abs()
-                && (plain.1 - batch.1).abs() <= 1e-9 * plain.1.abs();
-            row.push((threads, plain.0, hinted.0, batch.0, volume.0, agree));
+            let mut vol_out = vec![0.0; vol_n];
+            let volume_batch = tp.install(|| {
+                rate(vol_n, secs, || {
+                    g.query_sizes_volume(&pts[..vol_n], 1.2, &mut vol_out)
+                        .map_or(f64::NAN, |_| vol_out.iter().sum())
+                })
+            });
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs();
+            let agree = close(plain.1, hinted.1)
+                && close(plain.1, batch.1)
+                && close(volume.1, volume_batch.1);
+            row.push((
+                threads,
+                plain.0,
+                hinted.0,
+                batch.0,
+                volume.0,
+                volume_batch.0,
+                agree,
+            ));
         }
         pb.finish_and_clear();
         rows.push((set.name, row));
@@ -123,8 +140,9 @@ pub fn run(path: &Path, n: usize, secs: f64, as_json: bool) -> Result<()> {
             "sizes": field, "points_per_set": n, "query_bytes_per_triangle": bpt,
             "results": rows.iter().map(|(name, r)| json!({
                 "set": name,
-                "runs": r.iter().map(|(t, p, h, b, vol, ok)| json!({
-                    "threads": t, "plain_qps": p, "hinted_qps": h, "batch_qps": b, "volume_qps": vol, "answers_agree": ok
+                "runs": r.iter().map(|(t, p, h, b, vol, vb, ok)| json!({
+                    "threads": t, "plain_qps": p, "hinted_qps": h, "batch_qps": b, "volume_qps": vol,
+                    "volume_batch_qps": vb, "answers_agree": ok
                 })).collect::<Vec<_>>()
             })).collect::<Vec<_>>()
         });
@@ -141,19 +159,26 @@ pub fn run(path: &Path, n: usize, secs: f64, as_json: bool) -> Result<()> {
         n
     );
     println!(
-        "{:<13} {:>7} {:>14} {:>14} {:>14} {:>14}  answers",
-        "point set", "threads", "plain q/s", "hinted q/s", "batch q/s", "volume q/s"
+        "{:<13} {:>7} {:>14} {:>14} {:>14} {:>14} {:>14}  answers",
+        "point set",
+        "threads",
+        "plain q/s",
+        "hinted q/s",
+        "batch q/s",
+        "volume q/s",
+        "vol. batch q/s"
     );
     for (name, r) in &rows {
-        for (t, p, h, b, vol, ok) in r {
+        for (t, p, h, b, vol, vb, ok) in r {
             println!(
-                "{:<13} {:>7} {:>14.0} {:>14.0} {:>14.0} {:>14.0}  {}",
+                "{:<13} {:>7} {:>14.0} {:>14.0} {:>14.0} {:>14.0} {:>14.0}  {}",
                 name,
                 t,
                 p,
                 h,
                 b,
                 vol,
+                vb,
                 if *ok { "identical" } else { "DIFFER" }
             );
         }

@@ -22,10 +22,12 @@
 //! - **hinted**: the same answer, with the search bound seeded by a triangle the
 //!   caller kept from a nearby query (advancing fronts query neighbours).
 //! - **batch**: many points in parallel (rayon), each answer identical to the
-//!   single query, whatever the thread count.
+//!   single query, whatever the thread count; a scattered batch is answered
+//!   along a Morton curve ([`order`]), for warmer caches.
 //! - **volume**: `H(x) = min_y [h(y) + ln β · |x − y|]` over the surface, by branch
 //!   and bound (see [`volume`]).
 
+mod order;
 pub mod volume;
 
 use crate::error::{Error, Result};
@@ -110,7 +112,10 @@ impl Grid {
     }
 
     /// Sizes at many points, in parallel; `out[i]` answers `points[i]`.
-    /// All points are checked first: on error nothing is written.
+    /// All points are checked first: on error nothing is written. A scattered
+    /// batch is answered in Morton order ([`order`]: the same answers, in
+    /// about half the time for points in random order).
+    /// O(n log F + n log n).
     pub fn query_sizes(&self, points: &[[f64; 3]], out: &mut [f64]) -> Result<()> {
         self.require_sizes()?;
         check_batch(points, out.len())?;
@@ -119,16 +124,29 @@ impl Grid {
         if self.topology().body_count > 1 {
             self.contact_lists();
         }
-        points
+        // Each chunk of consecutive points chains its hints.
+        let run = |ps: &mut dyn Iterator<Item = &[f64; 3]>, os: &mut [f64]| -> Result<()> {
+            let mut hint = u32::MAX;
+            for (p, o) in ps.zip(os.iter_mut()) {
+                *o = self.query_size_hinted(*p, &mut hint)?;
+            }
+            Ok(())
+        };
+        let Some(order) = order::batch_order(points) else {
+            return points
+                .par_chunks(BATCH_CHUNK)
+                .zip(out.par_chunks_mut(BATCH_CHUNK))
+                .try_for_each(|(ps, os)| run(&mut ps.iter(), os));
+        };
+        let mut sorted = vec![0.0; points.len()];
+        order
             .par_chunks(BATCH_CHUNK)
-            .zip(out.par_chunks_mut(BATCH_CHUNK))
-            .try_for_each(|(ps, os)| {
-                let mut hint = u32::MAX;
-                for (p, o) in ps.iter().zip(os.iter_mut()) {
-                    *o = self.query_size_hinted(*p, &mut hint)?;
-                }
-                Ok(())
-            })
+            .zip(sorted.par_chunks_mut(BATCH_CHUNK))
+            .try_for_each(|(is, os)| run(&mut is.iter().map(|&i| &points[i as usize]), os))?;
+        for (&i, v) in order.iter().zip(sorted) {
+            out[i as usize] = v;
+        }
+        Ok(())
     }
 
     /// The tie rule between bodies (module doc): `size`, the size at the
@@ -326,15 +344,36 @@ mod tests {
     #[test]
     fn batch_equals_single() {
         let g = plate();
-        let pts: Vec<[f64; 3]> = (0..2000)
+        // Scattered (answered in Morton order) and coherent (in their order).
+        let scattered: Vec<[f64; 3]> = (0..2000)
             .map(|k| [(k as f64 * 0.37) % 1.3, (k as f64 * 0.11) % 1.1, 0.1])
             .collect();
-        let mut out = vec![0.0; pts.len()];
-        g.query_sizes(&pts, &mut out).unwrap();
-        for (p, o) in pts.iter().zip(&out) {
-            assert_eq!(*o, g.query_size(*p).unwrap());
+        let coherent: Vec<[f64; 3]> = (0..2000)
+            .map(|k| [k as f64 * 5e-4, 0.3 + 0.2 * (k as f64 * 0.01).sin(), 0.1])
+            .collect();
+        assert!(super::order::batch_order(&scattered).is_some());
+        assert!(super::order::batch_order(&coherent).is_none());
+        for pts in [&scattered, &coherent] {
+            for threads in [1, 3] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let mut out = vec![0.0; pts.len()];
+                let mut vol = vec![0.0; pts.len()];
+                pool.install(|| {
+                    g.query_sizes(pts, &mut out).unwrap();
+                    g.query_sizes_volume(pts, 1.2, &mut vol).unwrap();
+                });
+                for (i, p) in pts.iter().enumerate() {
+                    assert_eq!(out[i].to_bits(), g.query_size(*p).unwrap().to_bits());
+                    let v = g.query_volume(*p, 1.2).unwrap().size;
+                    assert_eq!(vol[i].to_bits(), v.to_bits());
+                }
+            }
+            let mut out = vec![0.0; pts.len()];
+            assert!(g.query_sizes(pts, &mut out[1..]).is_err());
         }
-        assert!(g.query_sizes(&pts, &mut out[1..]).is_err());
     }
 
     #[test]

@@ -135,7 +135,9 @@ impl Grid {
         Ok(self.volume_with_slope(x, s))
     }
 
-    /// Batch of volume queries in parallel; `out[i]` answers `points[i]`.
+    /// Batch of volume queries in parallel; `out[i]` answers `points[i]`,
+    /// the same value as [`Grid::query_volume`]. A scattered batch is
+    /// answered in Morton order (see [`Grid::query_sizes`]).
     pub fn query_sizes_volume(
         &self,
         points: &[[f64; 3]],
@@ -145,10 +147,22 @@ impl Grid {
         let s = slope_from_beta(beta)?;
         self.require_sizes()?;
         check_batch(points, out.len())?;
-        out.par_iter_mut()
-            .zip(points.par_iter())
+        let Some(order) = super::order::batch_order(points) else {
+            out.par_iter_mut()
+                .zip(points.par_iter())
+                .with_min_len(64)
+                .for_each(|(o, p)| *o = self.volume_with_slope(*p, s).size);
+            return Ok(());
+        };
+        // In Morton order (see `query_sizes`): the same answers, warmer caches.
+        let sorted: Vec<f64> = order
+            .par_iter()
             .with_min_len(64)
-            .for_each(|(o, p)| *o = self.volume_with_slope(*p, s).size);
+            .map(|&i| self.volume_with_slope(points[i as usize], s).size)
+            .collect();
+        for (&i, v) in order.iter().zip(sorted) {
+            out[i as usize] = v;
+        }
         Ok(())
     }
 
