@@ -819,7 +819,12 @@ abgs_status abgs_query_size_hinted(const abgs_grid *grid,
 
 // Sizes at `n` points (`points`: 3n doubles) into `out_sizes` (n doubles),
 // in parallel on the rayon thread pool (`RAYON_NUM_THREADS` sets its size).
-// Results equal the single queries', whatever the thread count. All points are
+// Results equal the single queries', whatever the thread count. A scattered
+// batch (1,024 points or more whose consecutive points lie farther apart than
+// 1/100 of the batch's box diagonal on average) is answered along a Morton
+// curve for warmer caches, in about half the time for random points, with up
+// to 20 bytes per point of scratch memory; `out_sizes[i]` still answers point
+// `i`, bit for bit. All points are
 // checked first: on error nothing is written. `points` and `out_sizes` must not
 // overlap.
 //
@@ -843,7 +848,8 @@ abgs_status abgs_query_size_volume(const abgs_grid *grid,
                                    double beta,
                                    double *out_size);
 
-// Batch of volume-mode queries, in parallel (see `abgs_query_sizes`; the buffers
+// Batch of volume-mode queries, in parallel, a scattered batch along a Morton
+// curve (see `abgs_query_sizes`: the same answers as single queries; the buffers
 // must not overlap).
 //
 // # Safety

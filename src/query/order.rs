@@ -15,8 +15,9 @@
 //! # Cost
 //! O(n log n): one 63-bit code per point (21 bits per axis of the batch's
 //! box), a parallel unstable sort of `(code, index)` pairs (a total order, so
-//! the same permutation for any thread count), 12 bytes per point while the
-//! batch runs. The caller's order is kept below [`MIN_SORTED`] points and for
+//! the same permutation for any thread count); 20 bytes per point at most
+//! while sorting (the keyed pairs and the order), 12 while the batch runs (the
+//! order and the answers). The caller's order is kept below [`MIN_SORTED`] points and for
 //! a batch that is coherent already: one whose consecutive points lie, on
 //! average, within [`COHERENT_STEP`] of the batch's box diagonal of each
 //! other (an advancing front's queries step by about an element size). There
