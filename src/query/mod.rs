@@ -23,7 +23,7 @@
 //!   caller kept from a nearby query (advancing fronts query neighbours).
 //! - **batch**: many points in parallel (rayon), each answer identical to the
 //!   single query, whatever the thread count; a scattered batch is answered
-//!   along a Morton curve ([`order`]), for warmer caches.
+//!   along a Morton curve (module `order`), for warmer caches.
 //! - **volume**: `H(x) = min_y [h(y) + ln β · |x − y|]` over the surface, by branch
 //!   and bound (see [`volume`]).
 
@@ -113,7 +113,7 @@ impl Grid {
 
     /// Sizes at many points, in parallel; `out[i]` answers `points[i]`.
     /// All points are checked first: on error nothing is written. A scattered
-    /// batch is answered in Morton order ([`order`]: the same answers, in
+    /// batch is answered in Morton order (module `order`: the same answers, in
     /// about half the time for points in random order).
     /// O(n log F + n log n).
     pub fn query_sizes(&self, points: &[[f64; 3]], out: &mut [f64]) -> Result<()> {
