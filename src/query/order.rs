@@ -3,9 +3,11 @@
 //! worker lie near each other.
 //!
 //! # Why
-//! A closest-point search is bound by memory latency: on a 100k-face grid most
-//! of its time is the first touch of the tree nodes and triangle corners on
-//! its path. Points given in random order (a volume mesher's interior points,
+//! A closest-point search is bound by memory latency: on a 100k-face grid its
+//! hottest instructions are the first loads of the tree nodes and triangle
+//! corners on its path, and near-surface points in random order cost about
+//! twice a coherent walk's (occt_bearing_housing: 1.16 against 0.53 µs per
+//! query). Points given in random order (a volume mesher's interior points,
 //! a sampled cloud) touch a cold path each; points in curve order share most
 //! of the path with their predecessor, whose answer also seeds the next
 //! search's bound (the hint). The answers do not change: each is a function of
