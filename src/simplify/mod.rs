@@ -54,6 +54,7 @@ use crate::error::{Error, Result};
 use crate::mesh::feature_lines::{feature_lines, FeatureLines};
 use crate::mesh::halfedge::{HalfedgeMesh, NONE, V_CORNER};
 use crate::mesh::{BuildOptions, Features, Grid};
+use crate::spatial::LabelForest;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -432,6 +433,8 @@ struct TargetParts {
     /// Per target vertex: its reach (see
     /// [`crate::spatial::StarMesh`]).
     reach: Vec<f64>,
+    /// A BVH per target patch.
+    patches: LabelForest,
 }
 
 impl TargetParts {
@@ -446,6 +449,7 @@ impl TargetParts {
             envelope: &self.envelope,
             contact: grid.contact_faces(),
             reach: &self.reach,
+            patches: &self.patches,
         }
     }
 }
@@ -474,6 +478,12 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
     let lim = params.limits();
     let envelope = envelope::Envelope::compute(grid, sizes, &features, lim.size_term, lim.kappa);
     let reach = Target::star_mesh(grid, &features.face_patch).reaches();
+    let patches = LabelForest::build(
+        grid.vertices(),
+        grid.triangles(),
+        &features.face_patch,
+        features.patch_count,
+    );
     // The tie rule's contact faces and lists, built here in parallel rather
     // than lazily (and sequentially) inside the parallel estimates.
     if grid.topology().body_count > 1 {
@@ -487,6 +497,7 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
             seg_sizes,
             envelope,
             reach,
+            patches,
         },
     ))
 }

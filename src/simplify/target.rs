@@ -25,7 +25,7 @@ use crate::geometry::{cross, lerp, sub};
 use crate::mesh::feature_lines::FeatureLines;
 use crate::mesh::shape::unit;
 use crate::mesh::Grid;
-use crate::spatial::StarMesh;
+use crate::spatial::{LabelForest, StarMesh};
 
 /// Where a point lands on the target.
 #[derive(Debug, Clone, Copy)]
@@ -65,6 +65,9 @@ pub struct Target<'a> {
     /// not containing it), for searches that start from a known triangle
     /// ([`StarMesh::reaches`]).
     pub reach: &'a [f64],
+    /// A BVH per patch, for the projections the star search cannot
+    /// certify (see [`LabelForest`]).
+    pub patches: &'a LabelForest,
 }
 
 impl<'a> Target<'a> {
@@ -107,9 +110,9 @@ impl<'a> Target<'a> {
 
     /// Closest point of `p` on patch `patch` (anywhere on the target when the
     /// patch is empty), starting from triangle `hint`: in the star of the
-    /// hint's corner nearest `p` when its certificate holds, else by the BVH
-    /// (the same answer either way, see [`StarMesh`]). O(1) near the hint,
-    /// O(log F) typically.
+    /// hint's corner nearest `p` when its certificate holds, else by the
+    /// patch's own BVH (the same answer either way, see [`StarMesh`] and
+    /// [`LabelForest`]). O(1) near the hint, O(log F) typically.
     pub fn on_patch(&self, p: [f64; 3], patch: u32, hint: u32) -> Option<Hit> {
         let bvh = self.grid.bvh();
         let near =
@@ -118,7 +121,8 @@ impl<'a> Target<'a> {
             Ok(hit) => hit,
             Err(seed) => {
                 let hint = (seed != u32::MAX).then_some(seed);
-                bvh.closest_filtered(p, hint, |t| self.face_patch[t as usize] == patch)
+                self.patches
+                    .closest(p, patch, hint)
                     .or_else(|| bvh.closest(p, None))?
             }
         };
