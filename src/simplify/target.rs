@@ -122,7 +122,7 @@ impl<'a> Target<'a> {
             Err(seed) => {
                 let hint = (seed != u32::MAX).then_some(seed);
                 self.patches
-                    .closest(p, patch, hint)
+                    .closest(bvh, p, patch, hint)
                     .or_else(|| bvh.closest(p, None))?
             }
         };

@@ -61,6 +61,21 @@ pub struct Bvh {
     pub coord_scale: f64,
 }
 
+/// Where a search reads the corners of a primitive slot (leaf order): the
+/// tree's own [`Bvh::prim_corners`], or another structure holding the same
+/// triangles (see [`Bvh::closest_with_corners`]).
+pub(crate) trait Corners {
+    /// The corners of the triangle in primitive slot `slot`.
+    fn corners(&self, slot: usize) -> &[[f64; 3]; 3];
+}
+
+impl Corners for [[[f64; 3]; 3]] {
+    #[inline(always)]
+    fn corners(&self, slot: usize) -> &[[f64; 3]; 3] {
+        &self[slot]
+    }
+}
+
 /// Best candidate of a closest-point search.
 struct Best {
     tri: u32,
@@ -258,17 +273,45 @@ impl Bvh {
         keep: impl Fn(u32) -> bool,
         keep_node: impl Fn(usize) -> bool,
     ) -> Option<ClosestHit> {
+        self.search_with(p, hint, bound2, keep, keep_node, &self.prim_corners[..])
+    }
+
+    /// [`Bvh::closest`] with the corners of each primitive slot read from
+    /// `corners` instead of [`Bvh::prim_corners`] (which may then be
+    /// empty): for a tree that shares its triangles' corners with another
+    /// structure. The corners must be those the tree was built over, in
+    /// their order, for the answer to be [`Bvh::closest`]'s. Expected
+    /// O(log F).
+    pub(crate) fn closest_with_corners(
+        &self,
+        p: [f64; 3],
+        hint: Option<u32>,
+        corners: &impl Corners,
+    ) -> Option<ClosestHit> {
+        self.search_with(p, hint, f64::INFINITY, |_| true, |_| true, corners)
+    }
+
+    /// [`Bvh::search`] reading the corners from `corners`.
+    fn search_with(
+        &self,
+        p: [f64; 3],
+        hint: Option<u32>,
+        bound2: f64,
+        keep: impl Fn(u32) -> bool,
+        keep_node: impl Fn(usize) -> bool,
+        corners: &(impl Corners + ?Sized),
+    ) -> Option<ClosestHit> {
         if self.nodes.is_empty() {
             return None;
         }
         let mut best = Best::new(p, bound2, self.pad(&p));
         // In range first: `keep` may index by triangle.
         if let Some(h) = hint.filter(|&h| (h as usize) < self.triangle_prim.len() && keep(h)) {
-            let c = &self.prim_corners[self.triangle_prim[h as usize] as usize];
+            let c = corners.corners(self.triangle_prim[h as usize] as usize);
             best.offer(h, closest_point_triangle(p, c[0], c[1], c[2]));
         }
         if self.nodes[0].bbox.distance2(&p) <= best.limit {
-            self.descend(&p, &mut best, &keep, &keep_node);
+            self.descend(&p, &mut best, &keep, &keep_node, corners);
         }
         (best.tri != u32::MAX).then_some(ClosestHit {
             triangle: best.tri,
@@ -383,13 +426,20 @@ impl Bvh {
 
     /// Scans the primitives of leaf `leaf`.
     #[inline]
-    fn scan_leaf(&self, leaf: usize, p: &[f64; 3], best: &mut Best, keep: &impl Fn(u32) -> bool) {
+    fn scan_leaf(
+        &self,
+        leaf: usize,
+        p: &[f64; 3],
+        best: &mut Best,
+        keep: &impl Fn(u32) -> bool,
+        corners: &(impl Corners + ?Sized),
+    ) {
         let n = &self.nodes[leaf];
         let s = n.start as usize;
         for slot in s..s + n.count as usize {
             let tri = self.prim_triangle[slot];
             if keep(tri) {
-                let c = &self.prim_corners[slot];
+                let c = corners.corners(slot);
                 best.offer(tri, closest_point_triangle(*p, c[0], c[1], c[2]));
             }
         }
@@ -416,6 +466,7 @@ impl Bvh {
         best: &mut Best,
         keep: &impl Fn(u32) -> bool,
         keep_node: &impl Fn(usize) -> bool,
+        corners: &(impl Corners + ?Sized),
     ) {
         // Uninitialised storage: zeroing a fixed array costs more than the walk.
         let mut stack: ArrayVec<(u32, f64), MAX_DEPTH> = ArrayVec::new();
@@ -425,7 +476,7 @@ impl Bvh {
             if !keep_node(node) {
                 // Nothing below is accepted: pop the next node.
             } else if n.is_leaf() {
-                self.scan_leaf(node, p, best, keep);
+                self.scan_leaf(node, p, best, keep, corners);
             } else {
                 let (near, dn, far, df) = self.children_by_distance(node, p);
                 if dn <= best.limit {

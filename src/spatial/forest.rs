@@ -18,15 +18,18 @@
 //!
 //! Build: the triangles grouped by label (ascending index within a group),
 //! one [`Bvh::build`] per label, labels in parallel: O(F log F) in all.
-//! Memory: one more [`Bvh`] over every triangle (about 120 bytes per
-//! triangle) plus 4 bytes per triangle for the group lists. A query is a
-//! search of one tree, O(log F_label) expected. Within a group, local
-//! triangle order is global order and each tree holds the triangles' corners
-//! in their own order, so an answer is [`Bvh::closest_filtered`]'s with the
-//! same filter bit for bit: the triangle (ties to the lowest index), the
-//! closest point and the distance.
+//! Memory: the trees' nodes and slot maps (about 45 bytes per triangle)
+//! plus 4 bytes per triangle for the group lists; the trees keep no corners
+//! of their own but read the whole grid's tree's ([`Bvh::prim_corners`],
+//! two more indirections per triangle tested), which saves 72 bytes per
+//! triangle. A query is a search of one tree, O(log F_label) expected.
+//! Within a group, local triangle order is global order and the corners
+//! are the grid tree's, in the triangles' own order, so an answer is
+//! [`Bvh::closest_filtered`]'s with the same filter bit for bit: the
+//! triangle (ties to the lowest index), the closest point and the
+//! distance.
 
-use super::bvh::{Bvh, ClosestHit};
+use super::bvh::{Bvh, ClosestHit, Corners};
 use rayon::prelude::*;
 
 /// A [`Bvh`] per label over the triangles carrying it. Immutable after
@@ -77,7 +80,10 @@ impl LabelForest {
             .map(|l| {
                 let group = &members[offsets[l] as usize..offsets[l + 1] as usize];
                 let local: Vec<[u32; 3]> = group.iter().map(|&t| triangles[t as usize]).collect();
-                Bvh::build(vertices, &local)
+                let mut tree = Bvh::build(vertices, &local);
+                // The corners are read from the whole grid's tree.
+                tree.prim_corners = Vec::new();
+                tree
             })
             .collect();
         LabelForest {
@@ -101,18 +107,42 @@ impl LabelForest {
     /// The exact closest point of `p` among the triangles labelled `label`
     /// (triangle indices global), seeded by triangle `hint` when it carries
     /// the label: [`Bvh::closest_filtered`] with the filter "label is
-    /// `label`", bit for bit. `None` when no triangle carries it. O(log F)
-    /// expected.
-    pub fn closest(&self, p: [f64; 3], label: u32, hint: Option<u32>) -> Option<ClosestHit> {
+    /// `label`", bit for bit. `bvh` is the tree over the same vertices and
+    /// triangles, whose corners the search reads. `None` when no triangle
+    /// carries the label. O(log F) expected.
+    pub fn closest(
+        &self,
+        bvh: &Bvh,
+        p: [f64; 3],
+        label: u32,
+        hint: Option<u32>,
+    ) -> Option<ClosestHit> {
         let l = label as usize;
         let tree = self.trees.get(l)?;
         let group = &self.members[self.offsets[l] as usize..self.offsets[l + 1] as usize];
         let local_hint = hint.and_then(|h| group.binary_search(&h).ok().map(|i| i as u32));
-        let hit = tree.closest(p, local_hint)?;
+        let corners = GroupCorners { tree, group, bvh };
+        let hit = tree.closest_with_corners(p, local_hint, &corners)?;
         Some(ClosestHit {
             triangle: group[hit.triangle as usize],
             closest: hit.closest,
         })
+    }
+}
+
+/// The corners of a label's tree, read from the whole grid's tree: slot →
+/// local triangle → global triangle → the grid tree's slot.
+struct GroupCorners<'a> {
+    tree: &'a Bvh,
+    group: &'a [u32],
+    bvh: &'a Bvh,
+}
+
+impl Corners for GroupCorners<'_> {
+    #[inline(always)]
+    fn corners(&self, slot: usize) -> &[[f64; 3]; 3] {
+        let t = self.group[self.tree.prim_triangle[slot] as usize];
+        &self.bvh.prim_corners[self.bvh.triangle_prim[t as usize] as usize]
     }
 }
 
@@ -147,7 +177,7 @@ mod tests {
             for label in 0..6u32 {
                 let hint = Some((rng(&mut seed) * (t.len() + 5) as f64) as u32);
                 let want = bvh.closest_filtered(p, None, |u| labels[u as usize] == label);
-                let got = forest.closest(p, label, hint);
+                let got = forest.closest(&bvh, p, label, hint);
                 match (want, got) {
                     (None, None) => assert!(label == 2 || label >= 5),
                     (Some(w), Some(g)) => {
@@ -169,7 +199,7 @@ mod tests {
         let p = [0.5, 0.5, 1.0];
         assert_eq!(
             forest
-                .closest(p, 0, Some(t.len() as u32 - 1))
+                .closest(&bvh, p, 0, Some(t.len() as u32 - 1))
                 .unwrap()
                 .triangle,
             bvh.closest(p, None).unwrap().triangle
