@@ -224,7 +224,14 @@ impl Bvh {
         hint: Option<u32>,
         keep: impl Fn(u32) -> bool,
     ) -> Option<ClosestHit> {
-        self.search(p, hint, f64::INFINITY, keep, |_| true)
+        self.search(
+            p,
+            hint,
+            f64::INFINITY,
+            keep,
+            |_| true,
+            &self.prim_corners[..],
+        )
     }
 
     /// [`Bvh::closest_filtered`] restricted to distances below `max_distance`
@@ -237,7 +244,14 @@ impl Bvh {
         max_distance: f64,
         keep: impl Fn(u32) -> bool,
     ) -> Option<ClosestHit> {
-        self.search(p, None, max_distance * max_distance, keep, |_| true)
+        self.search(
+            p,
+            None,
+            max_distance * max_distance,
+            keep,
+            |_| true,
+            &self.prim_corners[..],
+        )
     }
 
     /// [`Bvh::closest_filtered_within`] that also skips every node for which
@@ -253,7 +267,14 @@ impl Bvh {
         keep: impl Fn(u32) -> bool,
         keep_node: impl Fn(usize) -> bool,
     ) -> Option<ClosestHit> {
-        self.search(p, None, max_distance * max_distance, keep, keep_node)
+        self.search(
+            p,
+            None,
+            max_distance * max_distance,
+            keep,
+            keep_node,
+            &self.prim_corners[..],
+        )
     }
 
     /// For per-triangle labels `tri_label` (a body, say), the label shared by
@@ -261,19 +282,6 @@ impl Bvh {
     /// O(nodes).
     pub fn node_labels(&self, tri_label: &[u32]) -> Vec<u32> {
         self.fold_subtrees(tri_label, |a, b| if a == b { a } else { MIXED_LABEL })
-    }
-
-    /// Branch and bound from the bound `bound2` (squared distance), seeded by
-    /// `hint`: top-down from the root, nearer child first.
-    fn search(
-        &self,
-        p: [f64; 3],
-        hint: Option<u32>,
-        bound2: f64,
-        keep: impl Fn(u32) -> bool,
-        keep_node: impl Fn(usize) -> bool,
-    ) -> Option<ClosestHit> {
-        self.search_with(p, hint, bound2, keep, keep_node, &self.prim_corners[..])
     }
 
     /// [`Bvh::closest`] with the corners of each primitive slot read from
@@ -288,11 +296,13 @@ impl Bvh {
         hint: Option<u32>,
         corners: &impl Corners,
     ) -> Option<ClosestHit> {
-        self.search_with(p, hint, f64::INFINITY, |_| true, |_| true, corners)
+        self.search(p, hint, f64::INFINITY, |_| true, |_| true, corners)
     }
 
-    /// [`Bvh::search`] reading the corners from `corners`.
-    fn search_with(
+    /// Branch and bound from the bound `bound2` (squared distance), seeded by
+    /// `hint`: top-down from the root, nearer child first, the corners of
+    /// each primitive slot read from `corners`.
+    fn search(
         &self,
         p: [f64; 3],
         hint: Option<u32>,
