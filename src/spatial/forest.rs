@@ -18,8 +18,8 @@
 //!
 //! Build: the triangles grouped by label (ascending index within a group),
 //! one [`Bvh::build`] per label, labels in parallel: O(F log F) in all.
-//! Memory: the trees' nodes and slot maps (about 45 bytes per triangle)
-//! plus 4 bytes per triangle for the group lists; the trees keep no corners
+//! Memory: the trees' nodes (64 bytes each) and slot maps (8 bytes per
+//! triangle) plus 4 bytes per triangle for the group lists; the trees keep no corners
 //! of their own but read the whole grid's tree's ([`Bvh::prim_corners`],
 //! two more indirections per triangle tested), which saves 72 bytes per
 //! triangle. A query is a search of one tree, O(log F_label) expected.
@@ -91,17 +91,6 @@ impl LabelForest {
             members,
             trees,
         }
-    }
-
-    /// Bytes of heap memory held.
-    pub fn memory_bytes(&self) -> usize {
-        self.offsets.len() * 4
-            + self.members.len() * 4
-            + self
-                .trees
-                .iter()
-                .map(|t| t.memory_bytes() + std::mem::size_of::<Bvh>())
-                .sum::<usize>()
     }
 
     /// The exact closest point of `p` among the triangles labelled `label`
