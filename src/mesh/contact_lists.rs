@@ -20,12 +20,27 @@
 //! and takes the bodies in that order: [`Grid::other_bodies_within`]'s answer
 //! bit for bit, for any `q` on `t`.
 //!
+//! # Sorted by distance, so a lookup stops early
+//!
+//! Each listed face `u` keeps `ℓ_u`, a lower bound of its distance to `m`
+//! (the computed distance less `8s`, rounded down to `f32`), and a list is
+//! sorted by `(ℓ_u, u)`. A point `q` at `ρ = |q − m|` has `|q − u| ≥
+//! |m − u| − ρ ≥ ℓ_u − ρ`, so once `ℓ_u > ρ + c + 8s` (with a relative margin)
+//! no face from `u` on can lie within the gap, nor be *computed* within it
+//! (computed distances near `q` err by less than `s`), and the scan ends
+//! there: a lookup near one corner of a face reads the part of its list
+//! around that corner, and skips the other faces' corners (random reads)
+//! altogether. The answer does not depend on the order in which faces are
+//! read (each body's best face is chosen by distance, then index), so it
+//! stays the BVH's bit for bit.
+//!
 //! # Cost and ties
 //!
 //! Built on first use: one bounded BVH range search per contact face, in
 //! fixed chunks (so the lists are the same for any thread count), parallel
 //! unless first reached on a rayon worker ([`super::on_rayon_worker`]),
-//! O(Fc log F). Memory: 4 bytes per face (offsets) plus 4 per listed face. A
+//! O(Fc log F). Memory: 4 bytes per face (offsets) plus 8 per listed face
+//! (the face and its bound). A
 //! list longer than [`MAX_LIST`] (another body's faces far finer than this
 //! one's) is not kept: such a face answers through the BVH, as before. A
 //! lookup is O(k) point–triangle distances for k listed faces (a few on
@@ -53,9 +68,36 @@ const OVERFLOW: u32 = u32::MAX;
 pub(crate) struct ContactLists {
     /// Start of each face's list in `faces` (one more than the faces).
     offsets: Vec<u32>,
-    /// The listed faces, in the range search's order; `[OVERFLOW]` for a face
-    /// whose list was too long.
+    /// The listed faces, each list by ascending `(bound, face)`; `[OVERFLOW]`
+    /// for a face whose list was too long.
     faces: Vec<u32>,
+    /// Per listed face: a lower bound of its distance to the centroid of the
+    /// face whose list it is in (module doc); `INFINITY` beside `OVERFLOW`.
+    bounds: Vec<f32>,
+}
+
+/// A face's list: the other bodies' faces, ascending by `bounds`, a lower
+/// bound of each one's distance to the face's centroid (see the module doc).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct List<'a> {
+    /// The listed faces.
+    pub faces: &'a [u32],
+    /// Lower bounds of their distances to the centroid, ascending.
+    pub bounds: &'a [f32],
+}
+
+/// A listed face as built: (lower bound of its distance to the centroid,
+/// face).
+type Entry = (f32, u32);
+
+/// The largest `f32` not above `x` (`x ≥ 0` finite; 0 for NaN).
+fn f32_below(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) > x {
+        f32::from_bits(y.to_bits() - 1).max(0.0)
+    } else {
+        y.max(0.0)
+    }
 }
 
 impl ContactLists {
@@ -75,19 +117,24 @@ impl ContactLists {
                 let before = items.len();
                 if contact[f] {
                     let (m, r) = grid.centroid_ball(f);
-                    let reach = (r + gap) * (1.0 + 1e-9) + 8.0 * bvh.rounding_scale(&m);
+                    let s = bvh.rounding_scale(&m);
+                    let reach = (r + gap) * (1.0 + 1e-9) + 8.0 * s;
                     let own = body[f];
                     let full = within(
                         bvh,
                         m,
                         reach * reach,
+                        8.0 * s,
                         |u| body[u as usize] != own,
                         |n| nodes[n] != own,
                         &mut items,
                     );
-                    if !full {
+                    if full {
+                        items[before..]
+                            .sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+                    } else {
                         items.truncate(before);
-                        items.push(OVERFLOW);
+                        items.push((f32::INFINITY, OVERFLOW));
                     }
                 }
                 lens.push((items.len() - before) as u32);
@@ -95,7 +142,7 @@ impl ContactLists {
             (lens, items)
         };
         let all: Vec<usize> = (0..t.len()).collect();
-        let chunks: Vec<(Vec<u32>, Vec<u32>)> = if super::on_rayon_worker() {
+        let chunks: Vec<(Vec<u32>, Vec<Entry>)> = if super::on_rayon_worker() {
             all.chunks(CHUNK).map(list_chunk).collect()
         } else {
             all.par_chunks(CHUNK).map(list_chunk).collect()
@@ -109,49 +156,64 @@ impl ContactLists {
         let mut offsets = Vec::with_capacity(t.len() + 1);
         offsets.push(0u32);
         let mut faces = Vec::with_capacity(total);
+        let mut bounds = Vec::with_capacity(total);
         for (lens, items) in chunks {
             for l in lens {
                 offsets.push(offsets.last().copied().unwrap_or(0) + l);
             }
-            faces.extend_from_slice(&items);
+            faces.extend(items.iter().map(|i| i.1));
+            bounds.extend(items.iter().map(|i| i.0));
         }
-        ContactLists { offsets, faces }
+        ContactLists {
+            offsets,
+            faces,
+            bounds,
+        }
     }
 
     /// The list of face `f`: `None` when there is none kept (not a contact
     /// face, an overflowing list, or an index out of range). O(1).
-    pub(crate) fn get(&self, f: u32) -> Option<&[u32]> {
+    pub(crate) fn get(&self, f: u32) -> Option<List<'_>> {
         let f = f as usize;
         let (a, b) = (
             *self.offsets.get(f)? as usize,
             *self.offsets.get(f + 1)? as usize,
         );
-        let list = &self.faces[a..b];
-        (!list.is_empty() && list[0] != OVERFLOW).then_some(list)
+        let faces = &self.faces[a..b];
+        (!faces.is_empty() && faces[0] != OVERFLOW).then_some(List {
+            faces,
+            bounds: &self.bounds[a..b],
+        })
     }
 }
 
 /// Appends to `out` every triangle accepted by `keep` whose computed squared
-/// distance to `p` is at most `r2`, in the order [`Bvh::visit_within`] meets
-/// them, below nodes that `keep_node` accepts. False (with `out` partly
-/// filled) once more than [`MAX_LIST`] were found.
+/// distance to `p` is at most `r2`, as (lower bound of its distance: the
+/// computed one less `margin`, rounded down to `f32`; triangle), in the order
+/// [`Bvh::visit_within`] meets them, below nodes that `keep_node` accepts.
+/// False (with `out` partly filled) once more than [`MAX_LIST`] were found.
 fn within(
     bvh: &Bvh,
     p: [f64; 3],
     r2: f64,
+    margin: f64,
     keep: impl Fn(u32) -> bool,
     keep_node: impl Fn(usize) -> bool,
-    out: &mut Vec<u32>,
+    out: &mut Vec<Entry>,
 ) -> bool {
     let start = out.len();
     let overflowed = bvh.visit_within(p, r2, keep_node, |slot| {
         let u = bvh.prim_triangle[slot];
         let c = &bvh.prim_corners[slot];
-        if keep(u) && closest_point_triangle(p, c[0], c[1], c[2]).dist2 <= r2 {
+        if !keep(u) {
+            return false;
+        }
+        let d2 = closest_point_triangle(p, c[0], c[1], c[2]).dist2;
+        if d2 <= r2 {
             if out.len() - start == MAX_LIST {
                 return true;
             }
-            out.push(u);
+            out.push((f32_below(d2.sqrt() - margin), u));
         }
         false
     });
@@ -235,6 +297,39 @@ mod tests {
     }
 
     #[test]
+    fn lists_are_sorted_by_bounds_below_the_distances() {
+        let g = stack();
+        let lists = g.contact_lists();
+        let (bvh, t) = (g.bvh(), g.triangles());
+        let mut checked = 0;
+        for f in 0..t.len() {
+            let Some(list) = lists.get(f as u32) else {
+                continue;
+            };
+            assert_eq!(list.faces.len(), list.bounds.len());
+            let m = g.centroid(f);
+            for (k, (&u, &b)) in list.faces.iter().zip(list.bounds).enumerate() {
+                if k > 0 {
+                    let (pu, pb) = (list.faces[k - 1], list.bounds[k - 1]);
+                    assert!(pb < b || (pb == b && pu < u), "face {f}: not sorted");
+                }
+                let c = &bvh.prim_corners[bvh.triangle_prim[u as usize] as usize];
+                let d = crate::geometry::closest_point_triangle(m, c[0], c[1], c[2])
+                    .dist2
+                    .sqrt();
+                assert!((b as f64) <= d && b >= 0.0, "face {f}: bound {b} over {d}");
+                // Not uselessly loose: within the margins of the distance.
+                assert!(
+                    d - b as f64 <= 1e-6 * d.max(1e-3),
+                    "face {f}: {b} against {d}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+    }
+
+    #[test]
     fn built_on_a_worker_or_not_the_same() {
         let (g, h) = (stack(), stack());
         // This test's thread is no rayon worker: a parallel build.
@@ -251,6 +346,10 @@ mod tests {
         assert_eq!(fa, fb);
         assert_eq!(a.offsets, b.offsets);
         assert_eq!(a.faces, b.faces);
+        assert_eq!(
+            a.bounds.iter().map(|b| b.to_bits()).collect::<Vec<_>>(),
+            b.bounds.iter().map(|b| b.to_bits()).collect::<Vec<_>>()
+        );
         assert!(!a.faces.is_empty());
     }
 

@@ -450,12 +450,21 @@ impl Grid {
         })
     }
 
+    /// Centroid of triangle `f`, `(a + b + c) / 3` per coordinate (the
+    /// contact lists' bounds are measured from exactly this point). O(1).
+    #[inline]
+    pub(crate) fn centroid(&self, f: usize) -> [f64; 3] {
+        let v = &self.vertices;
+        let [a, b, c] = self.triangles[f].map(|i| v[i as usize]);
+        [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
+    }
+
     /// Centroid `m` of triangle `f` and its largest distance `r` to a corner:
     /// every point of the triangle lies within `r` of `m`. O(1).
     pub(crate) fn centroid_ball(&self, f: usize) -> ([f64; 3], f64) {
         let v = &self.vertices;
         let [a, b, c] = self.triangles[f].map(|i| v[i as usize]);
-        let m = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0);
+        let m = self.centroid(f);
         let r = [a, b, c]
             .iter()
             .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))

@@ -195,7 +195,16 @@ impl Grid {
         // computed distance is within the gap is skipped.
         let s = bvh.rounding_scale(&q);
         let box_limit = (gap + s) * (gap + s) * (1.0 + 1e-12);
-        for &u in list {
+        // The list is sorted by a lower bound of each face's distance to
+        // `tri`'s centroid: past `|q − m| + gap` (and the rounding margins)
+        // no face can be within the gap (see `mesh::contact_lists`).
+        let m = self.centroid(tri as usize);
+        let stop =
+            (crate::geometry::norm(crate::geometry::sub(q, m)) + gap + 2.0 * s) * (1.0 + 1e-9);
+        for (&u, &bound) in list.faces.iter().zip(list.bounds) {
+            if bound as f64 > stop {
+                break;
+            }
             let c = &bvh.prim_corners[bvh.triangle_prim[u as usize] as usize];
             if crate::geometry::triangle_box_distance2(c, &q) > box_limit {
                 continue;

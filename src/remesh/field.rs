@@ -277,17 +277,20 @@ impl SourceField {
             (f64::INFINITY, usize::MAX)
         };
         // Uninitialised storage; one net entry per level, so within capacity.
-        let mut stack: ArrayVec<u32, { MAX_DEPTH + 1 }> = ArrayVec::new();
-        stack.push(0);
-        while let Some(ni) = stack.pop() {
-            let ni = ni as usize;
-            let n = &self.bvh.nodes[ni];
-            if pruned(
-                self.node_min[ni] + self.slope * n.bbox.distance2(&p).sqrt(),
-                best,
-            ) {
+        // Each entry carries its node's bound, computed once when pushed (a
+        // square root per node, not two; the same pruning decisions).
+        let mut stack: ArrayVec<(f64, u32), { MAX_DEPTH + 1 }> = ArrayVec::new();
+        let root = &self.bvh.nodes[0];
+        stack.push((
+            self.node_min[0] + self.slope * root.bbox.distance2(&p).sqrt(),
+            0,
+        ));
+        while let Some((bound, ni)) = stack.pop() {
+            if pruned(bound, best) {
                 continue;
             }
+            let ni = ni as usize;
+            let n = &self.bvh.nodes[ni];
             if n.is_leaf() {
                 let s = n.start as usize;
                 for slot in s..s + n.count as usize {
@@ -302,10 +305,19 @@ impl SourceField {
                     self.node_min[l] + self.slope * self.bvh.nodes[l].bbox.distance2(&p).sqrt();
                 let dr =
                     self.node_min[r] + self.slope * self.bvh.nodes[r].bbox.distance2(&p).sqrt();
-                // Visit the more promising child first.
-                let (first, second) = if dl <= dr { (l, r) } else { (r, l) };
-                stack.push(second as u32);
-                stack.push(first as u32);
+                // Visit the more promising child first; a child already
+                // beyond the best is not pushed.
+                let (first, second) = if dl <= dr {
+                    ((dl, l), (dr, r))
+                } else {
+                    ((dr, r), (dl, l))
+                };
+                if !pruned(second.0, best) {
+                    stack.push((second.0, second.1 as u32));
+                }
+                if !pruned(first.0, best) {
+                    stack.push((first.0, first.1 as u32));
+                }
             }
         }
         if best_slot < slots {
