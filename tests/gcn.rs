@@ -245,7 +245,7 @@ fn the_tail_goes_on_where_the_model_stops_and_keeps_the_field() {
         let mut scorer = Learned::new(model);
         scorer.tail = tail;
         let s = abgs::simplify::simplify_with(&g, &gcn_params(false), &mut scorer, None).unwrap();
-        (s, scorer.tail_checks)
+        (s, scorer.tail_checks())
     };
     let (without, no_checks) = run(false);
     let (with, checks) = run(true);

@@ -492,10 +492,15 @@ pub(crate) fn run_tract_direct(
     })
 }
 
-/// A loaded model: one `ort` session (behind a mutex, as `ort` runs need `&mut`;
-/// concurrent [`Model::predict`] calls take turns).
+/// A loaded model: `ort` sessions of it, kept idle in a pool (a run needs
+/// `&mut`). A [`Model::predict`] takes an idle session, or opens one more from
+/// the model's bytes when all are busy (the parts of a mesh simplified side by
+/// side predict at once), and puts it back; so there are at most as many
+/// sessions as concurrent callers. Every session runs the same graph on its
+/// caller's thread alone, so which one answers changes no bit.
 pub struct Model {
-    session: Mutex<Session>,
+    idle: Mutex<Vec<Session>>,
+    bytes: Box<[u8]>,
     backend: Backend,
 }
 
@@ -519,25 +524,11 @@ impl Model {
             run_tract_direct(bytes, &trial_graph())
                 .map_err(|e| Error::Model(format!("trial run: {e}")))?;
         }
-        let session = guarded("creating the session", || {
-            let err = |e: ort::Error<ort::session::builder::SessionBuilder>| e.to_string();
-            let mut builder = Session::builder(&rt.env)
-                .map_err(|e| e.to_string())?
-                .with_optimization_level(GraphOptimizationLevel::All)
-                .map_err(err)?
-                .with_intra_threads(1)
-                .map_err(err)?
-                .with_inter_threads(1)
-                .map_err(err)?
-                .with_parallel_execution(false)
-                .map_err(err)?
-                .with_deterministic_compute(true)
-                .map_err(err)?;
-            builder.commit_from_memory(bytes).map_err(|e| e.to_string())
-        })
-        .map_err(|e| Error::Model(format!("{} cannot load the model: {e}", rt.about)))?;
+        let session = open_session(rt, bytes)
+            .map_err(|e| Error::Model(format!("{} cannot load the model: {e}", rt.about)))?;
         let model = Model {
-            session: Mutex::new(session),
+            idle: Mutex::new(vec![session]),
+            bytes: bytes.into(),
             backend: rt.backend,
         };
         model.predict(&trial_graph()).map_err(|e| match e {
@@ -596,34 +587,72 @@ impl Model {
         Ok(flat.chunks_exact(TARGETS).map(|c| [c[0], c[1]]).collect())
     }
 
-    /// One forward pass: the `pred` values, row-major, after checking its shape.
+    /// One forward pass on an idle session (or a new one): the `pred` values,
+    /// row-major, after checking their shape.
     fn run(&self, g: &GraphInputs) -> std::result::Result<Vec<f32>, String> {
-        let (n, e, k) = (g.n_nodes, g.n_edges, g.k);
-        let mut session = self.session.lock().unwrap_or_else(|p| p.into_inner());
-        guarded("running the model", || {
-            let err = |e: ort::Error| e.to_string();
-            let inputs = ort::inputs![
-                "node_x" => TensorRef::from_array_view(([n, NODE_FEATURES], &g.node_x[..])).map_err(err)?,
-                "edge_x" => TensorRef::from_array_view(([e, EDGE_FEATURES], &g.edge_x[..])).map_err(err)?,
-                "edge_ends" => TensorRef::from_array_view(([e, 2], &g.edge_ends[..])).map_err(err)?,
-                "nbr_node" => TensorRef::from_array_view(([n, k], &g.nbr_node[..])).map_err(err)?,
-                "nbr_edge" => TensorRef::from_array_view(([n, k], &g.nbr_edge[..])).map_err(err)?,
-                "nbr_mask" => TensorRef::from_array_view(([n, k], &g.nbr_mask[..])).map_err(err)?,
-            ];
-            let outputs = session.run(inputs).map_err(err)?;
-            let pred = outputs
-                .get(OUTPUT_NAME)
-                .ok_or_else(|| format!("no output '{OUTPUT_NAME}'"))?;
-            let (shape, data) = pred.try_extract_tensor::<f32>().map_err(err)?;
-            if **shape != [e as i64, TARGETS as i64] {
-                return Err(format!(
-                    "output shape {:?}, expected [{e}, {TARGETS}]",
-                    &**shape
-                ));
-            }
-            Ok(data.to_vec())
-        })
+        let idle = || self.idle.lock().unwrap_or_else(|p| p.into_inner());
+        let taken = idle().pop();
+        let mut session = match taken {
+            Some(s) => s,
+            None => open_session(runtime(None).map_err(|e| e.to_string())?, &self.bytes)?,
+        };
+        let out = run_session(&mut session, g);
+        // A session whose run failed is dropped, not reused.
+        if out.is_ok() {
+            idle().push(session);
+        }
+        out
     }
+}
+
+/// Opens an `ort` session of the ONNX `bytes` on runtime `rt`: one intra-op and
+/// one inter-op thread, sequential and deterministic (module doc).
+fn open_session(rt: &Runtime, bytes: &[u8]) -> std::result::Result<Session, String> {
+    guarded("creating the session", || {
+        let err = |e: ort::Error<ort::session::builder::SessionBuilder>| e.to_string();
+        let mut builder = Session::builder(&rt.env)
+            .map_err(|e| e.to_string())?
+            .with_optimization_level(GraphOptimizationLevel::All)
+            .map_err(err)?
+            .with_intra_threads(1)
+            .map_err(err)?
+            .with_inter_threads(1)
+            .map_err(err)?
+            .with_parallel_execution(false)
+            .map_err(err)?
+            .with_deterministic_compute(true)
+            .map_err(err)?;
+        builder.commit_from_memory(bytes).map_err(|e| e.to_string())
+    })
+}
+
+/// One forward pass of `session` on `g`: the `pred` values, row-major, after
+/// checking their shape.
+fn run_session(session: &mut Session, g: &GraphInputs) -> std::result::Result<Vec<f32>, String> {
+    let (n, e, k) = (g.n_nodes, g.n_edges, g.k);
+    guarded("running the model", || {
+        let err = |e: ort::Error| e.to_string();
+        let inputs = ort::inputs![
+            "node_x" => TensorRef::from_array_view(([n, NODE_FEATURES], &g.node_x[..])).map_err(err)?,
+            "edge_x" => TensorRef::from_array_view(([e, EDGE_FEATURES], &g.edge_x[..])).map_err(err)?,
+            "edge_ends" => TensorRef::from_array_view(([e, 2], &g.edge_ends[..])).map_err(err)?,
+            "nbr_node" => TensorRef::from_array_view(([n, k], &g.nbr_node[..])).map_err(err)?,
+            "nbr_edge" => TensorRef::from_array_view(([n, k], &g.nbr_edge[..])).map_err(err)?,
+            "nbr_mask" => TensorRef::from_array_view(([n, k], &g.nbr_mask[..])).map_err(err)?,
+        ];
+        let outputs = session.run(inputs).map_err(err)?;
+        let pred = outputs
+            .get(OUTPUT_NAME)
+            .ok_or_else(|| format!("no output '{OUTPUT_NAME}'"))?;
+        let (shape, data) = pred.try_extract_tensor::<f32>().map_err(err)?;
+        if **shape != [e as i64, TARGETS as i64] {
+            return Err(format!(
+                "output shape {:?}, expected [{e}, {TARGETS}]",
+                &**shape
+            ));
+        }
+        Ok(data.to_vec())
+    })
 }
 
 /// Two nodes joined by one edge, all features 0: the trial run of [`Model::from_bytes`].

@@ -2,7 +2,9 @@
 //! unit-free errors in one forward pass; the loop's thresholds turn them
 //! into scores, and only the best predictions get the cheap exact checks.
 //!
-//! Per iteration:
+//! The loop runs one such scorer per part of the mesh (each body of an
+//! assembly, side by side: [`EdgeScorer::for_part`]), so "the grid" below is
+//! the part's. Per iteration:
 //! 1. [`super::features::graph`] of the current grid, one forward pass:
 //!    `p = (Δs − 1, Δd / h_loc)` per edge;
 //! 2. the predicted score `ŷ = min(1, ½·max(p₀/(T_size − 1), p₁·h_loc/a_e,
@@ -61,6 +63,8 @@ use crate::simplify::scorer::{EdgeScorer, Ranking, View};
 use crate::simplify::select;
 use crate::simplify::Target;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 /// The distance envelope at edge `e` in model units: the smaller of the
 /// envelopes at the target triangles its two ends were projected from, for
@@ -97,17 +101,23 @@ pub struct Learned<'m> {
     /// Per vertex slot: inside the closed ring of an accepted edge (scratch,
     /// all false between calls).
     used: Vec<bool>,
-    /// Seconds spent in the forward passes (features included).
-    pub model_seconds: f64,
+    /// Forward-pass time and tail estimates, shared with the scorers of the
+    /// parts ([`Learned::model_seconds`], [`Learned::tail_checks`]).
+    tally: Arc<Tally>,
     /// Run the tail (stage 2, see the module doc) when the model's own
     /// choices run out (default true; false ends the loop there, as the
     /// paper's GCN-ABGS does).
     pub tail: bool,
-    /// Accurate estimates made in the tail so far.
-    pub tail_checks: usize,
     /// The predictions of the iteration they were made in: a ranking asked
     /// for again within the same iteration reuses them.
     cached: Option<(u32, Vec<f64>)>,
+}
+
+/// What the scorers of one run count, summed over its parts.
+#[derive(Debug, Default)]
+struct Tally {
+    model_nanos: AtomicU64,
+    tail_checks: AtomicUsize,
 }
 
 /// The tail's upper bound on the predicted score: `ŷ` is clamped to 1, so
@@ -123,11 +133,22 @@ impl<'m> Learned<'m> {
             refused: Vec::new(),
             ring: Vec::new(),
             used: Vec::new(),
-            model_seconds: 0.0,
+            tally: Arc::default(),
             tail: true,
-            tail_checks: 0,
             cached: None,
         }
+    }
+
+    /// Seconds spent in the forward passes (features included) by this
+    /// scorer and the scorers of its parts, summed over the parts.
+    pub fn model_seconds(&self) -> f64 {
+        self.tally.model_nanos.load(Ordering::Relaxed) as f64 * 1e-9
+    }
+
+    /// Accurate estimates made in the tail so far, by this scorer and the
+    /// scorers of its parts.
+    pub fn tail_checks(&self) -> usize {
+        self.tally.tail_checks.load(Ordering::Relaxed)
     }
 
     /// Predicted scores `ŷ` for every edge slot of `view.mesh` (∞ for
@@ -152,12 +173,25 @@ impl<'m> Learned<'m> {
         for (&e, s) in g.edges.iter().zip(scored) {
             y[e as usize] = s;
         }
-        self.model_seconds += t.elapsed().as_secs_f64();
+        let nanos = t.elapsed().as_nanos().min(u64::MAX as u128) as u64;
+        self.tally.model_nanos.fetch_add(nanos, Ordering::Relaxed);
         Ok(y)
     }
 }
 
 impl EdgeScorer for Learned<'_> {
+    /// GCN-ABGS, too, simplifies the parts of a mesh side by side: the model
+    /// runs on each part's own graph (the bodies of an assembly share no
+    /// edge, so a part's messages never cross to another; its global terms,
+    /// the mean pool and the mean edge length, are then the part's), each
+    /// part on a session of its own ([`Model`]).
+    fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send + '_>> {
+        let mut part = Learned::new(self.model);
+        part.tail = self.tail;
+        part.tally = Arc::clone(&self.tally);
+        Some(Box::new(part))
+    }
+
     fn rank(&mut self, view: &View) -> Result<Ranking> {
         let mesh = view.mesh;
         if self.refused.len() < mesh.n_edges() {
@@ -193,7 +227,9 @@ impl Learned<'_> {
             ..*view.lim
         };
         let tail = self.stage(view, y, p.t_score, TAIL_SCORE, &exact);
-        self.tail_checks += tail.estimated;
+        self.tally
+            .tail_checks
+            .fetch_add(tail.estimated, Ordering::Relaxed);
         Ranking {
             candidates: first.candidates + tail.candidates,
             estimated: first.estimated + tail.estimated,

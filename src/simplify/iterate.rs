@@ -16,7 +16,7 @@
 //! bodies of an assembly, never read or write each other: a collapse, a
 //! move or a flip changes only the part it is in, and the target it is held
 //! to is read-only. When the scorer ranks a part on its own terms
-//! ([`EdgeScorer::for_part`]; LBO-ABGS does), each part runs its own
+//! ([`EdgeScorer::for_part`]; LBO-ABGS and GCN-ABGS do), each part runs its own
 //! iterations with its own scorer, state and `n·|E|` budget, and the parts
 //! of one iteration run side by side on the rayon pool, largest first. An
 //! iteration ends when every part has done it (the progress callback and the
@@ -27,9 +27,12 @@
 //!
 //! What this changes against one loop over the whole mesh: the LBO ranking
 //! and the `n·|E|` budget are per body, so a body is not kept waiting for
-//! the smoother bodies of the assembly to run out of candidates. A mesh of
-//! one part is simplified exactly as one loop over it would (`cmp` on
-//! cgal_fandisk and forgescan_abc8).
+//! the smoother bodies of the assembly to run out of candidates; GCN-ABGS's
+//! forward pass runs on each body's own graph (messages never crossed
+//! between bodies, which share no edge, but the model's grid-wide terms are
+//! now the body's). A mesh of one part is simplified exactly as one loop
+//! over it would (`cmp` on cgal_fandisk and forgescan_abc8). Only the
+//! training-data observer, which sees the whole mesh, keeps one loop.
 //!
 //! Why it pays: within a part the estimates are parallel but the ranking,
 //! the claims, the collapses and the flips are sequential, about 40 % of
@@ -37,7 +40,9 @@
 //! machine (`perf`: the main thread held 29 % of the samples, the two
 //! workers the rest). Parts side by side overlap one part's sequential work
 //! with another's. The largest part bounds the gain (its sequential share is
-//! the critical path). Memory: the parts, each about its share of the
+//! the critical path). For GCN-ABGS the model's forward pass, which runs on
+//! its caller's thread alone, is most of an iteration: side by side the
+//! parts' passes run on every core. Memory: the parts, each about its share of the
 //! whole, in place of the whole mesh, plus per part a scorer cache
 //! (O(E) of the part).
 
@@ -218,11 +223,10 @@ pub(super) fn run(
     mut progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
     mut observer: Option<super::Observer>,
 ) -> Result<Looped> {
-    // One scorer per part, beside the parts (empty: the whole mesh with
-    // `scorer`).
-    let mut scorers: Vec<Box<dyn EdgeScorer + Send>> = Vec::new();
+    // One scorer per part, beside the parts, or `scorer` itself for the
+    // whole mesh.
     let by_parts = observer.is_none() && scorer.for_part().is_some();
-    let mut pieces: Vec<Piece> = if by_parts {
+    let (mut pieces, mut scorers, mut whole): (Vec<Piece>, Vec<_>, _) = if by_parts {
         let mut p: Vec<Piece> = mesh
             .into_parts()
             .into_iter()
@@ -230,10 +234,12 @@ pub(super) fn run(
             .map(|(i, m)| Piece::new(i, m))
             .collect();
         p.sort_by_key(|x| (std::cmp::Reverse(x.mesh.n_faces()), x.index));
-        scorers.extend(p.iter().filter_map(|_| scorer.for_part()));
-        p
+        let scorer: &dyn EdgeScorer = scorer;
+        let s: Vec<Box<dyn EdgeScorer + Send + '_>> =
+            p.iter().filter_map(|_| scorer.for_part()).collect();
+        (p, s, None)
     } else {
-        vec![Piece::new(0, mesh)]
+        (vec![Piece::new(0, mesh)], Vec::new(), Some(scorer))
     };
     let mut iterations = Vec::new();
     let mut stop = StopReason::MaxIterations;
@@ -269,7 +275,7 @@ pub(super) fn run(
                 rec.vertices += p.last.vertices;
                 rec.element_count += p.last.element_count;
             }
-        } else {
+        } else if let Some(scorer) = whole.as_deref_mut() {
             let p = &mut pieces[0];
             if let Some(obs) = observer.as_mut() {
                 obs(&p.view(cx, it, false))?;
@@ -370,12 +376,27 @@ mod tests {
 
     #[test]
     fn bodies_simplified_side_by_side_are_each_simplified_alone() {
+        side_by_side_as_alone(super::super::Method::Lbo);
+    }
+
+    /// GCN-ABGS's parts, too: each body's forward pass on its own graph.
+    #[cfg(feature = "gcn")]
+    #[test]
+    fn gcn_bodies_simplified_side_by_side_are_each_simplified_alone() {
+        side_by_side_as_alone(super::super::Method::Gcn);
+    }
+
+    /// Three sheets simplified as one grid by `method`, with 1 and 3
+    /// threads, give each sheet simplified alone: the same triangles and
+    /// sizes, and per iteration the sums of the parts' counts.
+    fn side_by_side_as_alone(method: super::super::Method) {
         let (alone, whole) = sheets();
         assert_eq!(whole.topology().body_count, 3);
         // Without the size fit: its solver's stop rule reads the whole
         // system (the positions do not depend on it).
         let params = SimplifyParams {
             fit_sizes: false,
+            method,
             ..Default::default()
         };
         let run = |g: &Grid, threads: usize| {

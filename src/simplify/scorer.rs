@@ -83,12 +83,12 @@ pub trait EdgeScorer {
     /// A fresh scorer of the same kind for one part of the mesh (a body cut
     /// apart from the others; the loop's module `simplify::iterate`), when
     /// this scorer ranks a part on its own terms: the loop then simplifies
-    /// the parts side by side, each with its own. `None` (the default) when
-    /// its ranking needs the whole mesh at once (a graph network's forward
-    /// pass over the whole graph): the loop then runs on the whole mesh
-    /// with this scorer. Every call must answer alike (all `Some` or all
-    /// `None`): the loop asks once per part.
-    fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send>> {
+    /// the parts side by side, each with its own (it may borrow from this
+    /// one, a model say). `None` (the default) when its ranking needs the
+    /// whole mesh at once: the loop then runs on the whole mesh with this
+    /// scorer. Every call must answer alike (all `Some` or all `None`): the
+    /// loop asks once per part.
+    fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send + '_>> {
         None
     }
 }
@@ -280,7 +280,7 @@ impl Accurate {
 
 impl EdgeScorer for Accurate {
     /// LBO-ABGS ranks each part by its own LBO order and budget.
-    fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send>> {
+    fn for_part(&self) -> Option<Box<dyn EdgeScorer + Send + '_>> {
         Some(Box::new(Accurate::default()))
     }
 
