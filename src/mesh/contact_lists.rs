@@ -53,7 +53,10 @@ use crate::spatial::Bvh;
 use rayon::prelude::*;
 
 /// Longest list kept; a face with more candidates answers through the BVH.
-pub(crate) const MAX_LIST: usize = 64;
+/// Since the lists are sorted (a lookup reads only the part near its point),
+/// 128 rather than 64: on the big assemblies the faces whose lists had
+/// overflowed at 64 cost more through the BVH than their longer lists do.
+pub(crate) const MAX_LIST: usize = 128;
 
 /// Faces per parallel chunk when building (a constant: same lists whatever
 /// the thread count).
