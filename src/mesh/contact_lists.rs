@@ -93,7 +93,8 @@ pub(crate) struct List<'a> {
 /// face).
 type Entry = (f32, u32);
 
-/// The largest `f32` not above `x` (`x ≥ 0` finite; 0 for NaN).
+/// The largest `f32` not above `x`, and not below 0 (a distance bound: a
+/// negative `x`, or NaN, gives 0).
 fn f32_below(x: f64) -> f32 {
     let y = x as f32;
     if (y as f64) > x {

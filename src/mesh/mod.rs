@@ -455,8 +455,7 @@ impl Grid {
     #[inline]
     pub(crate) fn centroid(&self, f: usize) -> [f64; 3] {
         let v = &self.vertices;
-        let [a, b, c] = self.triangles[f].map(|i| v[i as usize]);
-        [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
+        centroid3(self.triangles[f].map(|i| v[i as usize]))
     }
 
     /// Centroid `m` of triangle `f` and its largest distance `r` to a corner:
@@ -464,7 +463,7 @@ impl Grid {
     pub(crate) fn centroid_ball(&self, f: usize) -> ([f64; 3], f64) {
         let v = &self.vertices;
         let [a, b, c] = self.triangles[f].map(|i| v[i as usize]);
-        let m = self.centroid(f);
+        let m = centroid3([a, b, c]);
         let r = [a, b, c]
             .iter()
             .map(|&q| crate::geometry::norm(crate::geometry::sub(q, m)))
@@ -505,6 +504,12 @@ impl Grid {
     pub fn report(&self) -> &ValidationReport {
         &self.report
     }
+}
+
+/// `(a + b + c) / 3` per coordinate: [`Grid::centroid`]'s formula, in one place.
+#[inline]
+fn centroid3([a, b, c]: [[f64; 3]; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
 }
 
 /// True on a rayon worker thread. A lazy initialisation ([`Grid::contact_faces`],

@@ -41,8 +41,8 @@
 //! workers the rest). Parts side by side overlap one part's sequential work
 //! with another's. The largest part bounds the gain (its sequential share is
 //! the critical path). For GCN-ABGS the model's forward pass, which runs on
-//! its caller's thread alone, is most of an iteration: side by side the
-//! parts' passes run on every core. Memory: the parts, each about its share of the
+//! its caller's thread alone, is about half of the samples (`perf` on
+//! gmsh_bracket_assembly): side by side the parts' passes run on every core. Memory: the parts, each about its share of the
 //! whole, in place of the whole mesh, plus per part a scorer cache
 //! (O(E) of the part).
 
@@ -223,8 +223,8 @@ pub(super) fn run(
     mut progress: Option<&mut dyn FnMut(&IterationRecord) -> bool>,
     mut observer: Option<super::Observer>,
 ) -> Result<Looped> {
-    // One scorer per part, beside the parts, or `scorer` itself for the
-    // whole mesh.
+    // One scorer per part, beside the parts; or the whole mesh as one piece
+    // with `scorer` itself (`whole`).
     let by_parts = observer.is_none() && scorer.for_part().is_some();
     let (mut pieces, mut scorers, mut whole): (Vec<Piece>, Vec<_>, _) = if by_parts {
         let mut p: Vec<Piece> = mesh
@@ -249,7 +249,13 @@ pub(super) fn run(
             iteration: it as usize,
             ..Default::default()
         };
-        if by_parts {
+        if let Some(scorer) = whole.as_deref_mut() {
+            let p = &mut pieces[0];
+            if let Some(obs) = observer.as_mut() {
+                obs(&p.view(cx, it, false))?;
+            }
+            rec = step(&mut p.mesh, scorer, &mut p.stamps, &mut p.used, cx, it)?;
+        } else {
             let done: Vec<IterationRecord> = pieces
                 .par_iter_mut()
                 .zip(scorers.par_iter_mut())
@@ -275,12 +281,6 @@ pub(super) fn run(
                 rec.vertices += p.last.vertices;
                 rec.element_count += p.last.element_count;
             }
-        } else if let Some(scorer) = whole.as_deref_mut() {
-            let p = &mut pieces[0];
-            if let Some(obs) = observer.as_mut() {
-                obs(&p.view(cx, it, false))?;
-            }
-            rec = step(&mut p.mesh, scorer, &mut p.stamps, &mut p.used, cx, it)?;
         }
         rec.seconds = t.elapsed().as_secs_f64();
         iterations.push(rec);
