@@ -9,6 +9,10 @@
 //! length (default diagonal/100) or the sizes of a sizing grid, capped where the
 //! surface bends at half the curvature size `π / (κ · n_circle)` (optional).
 //!
+//! Before the iterations, two coarse levels at 4·L and 2·L
+//! ([`coarse_levels`]), so long input needles (CAD exports) are not split
+//! into slivers at L that the collapses then remove again.
+//!
 //! Features (dihedral angle above 30°, boundaries, non-manifold edges) are kept
 //! as constrained polylines; corners (feature valence ≠ 2, or a line turning by
 //! more than the corner angle) never move and are never removed. Bodies stay
@@ -20,7 +24,8 @@
 //!
 //! Cost: O(F log F) per iteration (projection dominates). Parallel (rayon):
 //! the parts of the mesh (its bodies, once the build has cut touching ones
-//! apart) are remeshed side by side, largest first, and within a part
+//! apart) are remeshed side by side, largest expected output first
+//! ([`expected_faces`]), and within a part
 //! relaxation and projection run in parallel; a part's topological passes
 //! are sequential, so a single large body gains only from the latter. The
 //! output does not depend on the thread count.
@@ -310,6 +315,7 @@ fn run(
         sliver_deg: params.sliver_angle_deg,
         fidelity: params.fidelity,
         cos_crease: params.feature_angle_deg.min(20.0).to_radians().cos(),
+        scale: 1.0,
     };
     // Sizes of corners (fixed) and everyone else (by projection).
     for v in 0..mesh.n_vertices() {
@@ -342,13 +348,20 @@ fn run(
         report.add(done);
         mesh
     } else {
-        let mut jobs: Vec<(usize, HalfedgeMesh)> =
-            mesh.into_parts().into_iter().enumerate().collect();
-        jobs.sort_by_key(|(i, m)| (std::cmp::Reverse(m.n_faces()), *i));
+        // Longest first by the work each will do (its output's size, not
+        // its input's: a part of a few long input triangles may become
+        // the largest), so the last to finish starts early.
+        let mut jobs: Vec<(f64, usize, HalfedgeMesh)> = mesh
+            .into_parts()
+            .into_iter()
+            .enumerate()
+            .map(|(i, m)| (expected_faces(&m), i, m))
+            .collect();
+        jobs.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let mut done: Vec<(usize, HalfedgeMesh, PartReport)> = jobs
             .into_par_iter()
             .with_max_len(1)
-            .map(|(i, mut m)| {
+            .map(|(_, i, mut m)| {
                 let r = iterate(&mut m, &reference, &lim, params);
                 (i, m, r)
             })
@@ -404,6 +417,58 @@ fn run(
     })
 }
 
+/// Coarse levels before the iterations, against the churn of long input
+/// needles: at L, a needle of length ℓ and width w ≪ L is split into about
+/// 2ℓ/L slivers whose cross edges (length ≈ w) the collapses then remove
+/// again. A level at scale s splits only what is longer than 4/3·s·L and
+/// lets a collapse of an edge shorter than 4/5·L make edges up to 4/3·s·L
+/// (still held to the surface by the unscaled fidelity tolerance), then
+/// flips and projects; levels s = 4, then 2. On a mesh without needles a
+/// level splits nothing, and its collapses only remove what the first
+/// iteration's would. Every part runs both (a per-part choice would make a
+/// part's result depend on the rest of the mesh whenever parts are
+/// remeshed as one). O(F log F) per level.
+pub(crate) fn coarse_levels(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) {
+    for scale in [4.0, 2.0] {
+        let level = Limits { scale, ..*lim };
+        ops::split_long(mesh, reference, &level);
+        ops::collapse_short(mesh, &level);
+        ops::repair_flat(mesh, &level, 0.02);
+        ops::flip_valence(mesh, &level);
+        mesh.compact();
+        smooth::relax_and_project(mesh, reference, true, level.cos_turn);
+    }
+}
+
+/// The faces a remeshed part will have, roughly: its area over the area of
+/// an equilateral triangle of the target length, face by face with the
+/// mean of the corners' targets (`vertex_size`; a non-finite or zero target
+/// counts nothing). A scheduling key only: the parts' work is about linear in
+/// their output, while their input faces say little of it (on
+/// trimesh_fm1_satellite a part of 6,502 input faces becomes 256,534, one of
+/// 22,876 becomes 175,762). O(F).
+fn expected_faces(mesh: &HalfedgeMesh) -> f64 {
+    let per_area = 4.0 / 3f64.sqrt();
+    mesh.faces()
+        .map(|f| {
+            let l = mesh
+                .face_vertices(f)
+                .map(|v| mesh.vertex_size[v as usize])
+                .iter()
+                .sum::<f64>()
+                / 3.0;
+            let n = mesh.face_normal2(f);
+            let area = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            let faces = per_area * area / (l * l);
+            if faces.is_finite() {
+                faces
+            } else {
+                0.0
+            }
+        })
+        .sum()
+}
+
 /// What [`iterate`] did to one part.
 struct PartReport {
     iterations: Vec<IterationReport>,
@@ -438,6 +503,7 @@ fn iterate(
     lim: &Limits,
     params: &RemeshParams,
 ) -> PartReport {
+    coarse_levels(mesh, reference, lim);
     let mut iterations = Vec::with_capacity(params.iterations);
     for _ in 0..params.iterations {
         let t = Instant::now();

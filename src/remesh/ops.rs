@@ -25,6 +25,11 @@ pub struct Limits {
     /// Cosine of the largest dihedral angle a flip may create (if it was not
     /// already there).
     pub cos_crease: f64,
+    /// Length scale of the splits and of the longest edge a collapse may
+    /// make: 1 in the remeshing iterations, more in a coarse level
+    /// ([`super::coarse_levels`]). The collapse threshold (4/5 of the target)
+    /// and the fidelity tolerance never scale.
+    pub scale: f64,
 }
 
 /// Mean target length of an edge's ends.
@@ -59,7 +64,7 @@ pub fn split_long(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) 
             })
             .filter_map(|e| {
                 let [a, b] = mesh.edge_vertices(e);
-                let l = target(mesh, a, b) * 4.0 / 3.0;
+                let l = target(mesh, a, b) * 4.0 / 3.0 * lim.scale;
                 let r = mesh.edge_length(e) / l;
                 (r > 1.0).then_some((r, e))
             })
@@ -73,7 +78,7 @@ pub fn split_long(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) 
         mesh.reserve_splits(long.len());
         for (_, e) in long {
             let [a, b] = mesh.edge_vertices(e);
-            let l = target(mesh, a, b) * 4.0 / 3.0;
+            let l = target(mesh, a, b) * 4.0 / 3.0 * lim.scale;
             let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
             if norm2(sub(pa, pb)) <= l * l {
                 continue;
@@ -151,7 +156,7 @@ pub fn collapse_ok(mesh: &HalfedgeMesh, h: u32, lim: &Limits) -> bool {
             let pu = mesh.positions[u as usize];
             let l_new = norm(sub(pu, pw));
             let l_old = norm(sub(pu, pv));
-            if l_new > (4.0 / 3.0 * target(mesh, w, u)).max(l_old) {
+            if l_new > (4.0 / 3.0 * lim.scale * target(mesh, w, u)).max(l_old) {
                 return false;
             }
             if mesh.edge_flags[mesh.edge(hh) as usize] & E_FEATURE != 0 {

@@ -99,3 +99,38 @@ fn parts_remeshed_apart_are_the_whole_remeshed() {
         assert_eq!(key(a, &whole.feature_edges), key(b, &parts.feature_edges));
     }
 }
+
+/// The parts' scheduling key predicts what remeshing makes: on a flat unit
+/// square (two input triangles) at L = 0.05, within a fifth of the faces
+/// the remesher writes, whatever the input's face count; a part without
+/// a finite target counts nothing.
+#[test]
+fn expected_faces_predicts_the_output() {
+    use crate::mesh::halfedge::HalfedgeMesh;
+    let opts = crate::mesh::BuildOptions {
+        weld_relative_tolerance: Some(1e-9),
+        orient: false,
+    };
+    let (v, t) = crate::test_shapes::unit_square(1, |_, _| 0.0);
+    let g = crate::mesh::Grid::from_arrays(v, t, None, &opts).unwrap();
+    let l0 = 0.05;
+    let (mut m, _) = HalfedgeMesh::from_grid(&g, None);
+    m.vertex_size.iter_mut().for_each(|h| *h = l0);
+    let expected = super::expected_faces(&m);
+    let want = 4.0 / 3f64.sqrt() / (l0 * l0);
+    assert!(
+        (expected - want).abs() < 1e-9 * want,
+        "{expected} vs {want}"
+    );
+    let made = run(&g, None, Some(l0), &RemeshParams::default(), false)
+        .unwrap()
+        .grid
+        .triangles()
+        .len() as f64;
+    assert!(
+        (made - expected).abs() < 0.2 * made,
+        "expected {expected}, made {made}"
+    );
+    m.vertex_size.iter_mut().for_each(|h| *h = f64::INFINITY);
+    assert_eq!(super::expected_faces(&m), 0.0);
+}
