@@ -38,6 +38,7 @@ use crate::mesh::Topology;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+pub mod parts;
 mod reference;
 #[cfg(test)]
 mod tests;
@@ -152,6 +153,20 @@ pub fn grade(
     h0: &[f64],
     s: f64,
 ) -> (Vec<f64>, GradationReport) {
+    grade_with(vertices, triangles, topo, h0, s, true)
+}
+
+/// [`grade`], returning `h0` unchanged when no face is too steep only if
+/// `early_exit` (a part of a larger mesh runs every step, as it would in the
+/// whole mesh when another part has a steep face; see [`parts`]).
+fn grade_with(
+    vertices: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    topo: &Topology,
+    h0: &[f64],
+    s: f64,
+    early_exit: bool,
+) -> (Vec<f64>, GradationReport) {
     assert_eq!(h0.len(), vertices.len(), "one initial size per vertex");
     let grid_ok = topo.face_edges.len() == triangles.len()
         && topo.vertex_face_offsets.len() == vertices.len() + 1;
@@ -163,14 +178,8 @@ pub fn grade(
         topo,
     };
     let (max0, bad0) = max_face_slope(vertices, triangles, h0, s);
-    if bad0 == 0 {
-        let ratio = max0 / s;
-        let report = GradationReport {
-            max_slope_ratio_before_fix: ratio,
-            max_slope_ratio: ratio,
-            ..Default::default()
-        };
-        return (h0.to_vec(), report);
+    if bad0 == 0 && early_exit {
+        return graded_already(h0, max0 / s);
     }
     let mut h = h0.to_vec();
     m.march(&mut h, s * (1.0 - SLACK), Update::Eikonal, None);
@@ -194,6 +203,17 @@ pub fn grade(
         max_slope_ratio: after / s,
     };
     (h, report)
+}
+
+/// The result of [`grade`] when no face is too steep: `h0` itself, with
+/// `ratio` its largest slope over `s`.
+fn graded_already(h0: &[f64], ratio: f64) -> (Vec<f64>, GradationReport) {
+    let report = GradationReport {
+        max_slope_ratio_before_fix: ratio,
+        max_slope_ratio: ratio,
+        ..Default::default()
+    };
+    (h0.to_vec(), report)
 }
 
 /// Heap entry: largest key first, then lowest index (a min-heap on values pushes

@@ -320,8 +320,12 @@ pub fn compute(grid: &Grid, params: &SizeParams) -> Result<SizeFields> {
     let t = Instant::now();
     let h = match slope {
         Some(s) => {
-            let grade = |h: &[f64]| {
-                gradation::grade(grid.vertices(), grid.triangles(), grid.topology(), h, s)
+            // Bodies apart grade side by side (the same field, see
+            // `gradation::parts`); the pieces are cut once for all rounds.
+            let pieces = gradation::parts::Pieces::new(grid.vertices(), grid.triangles());
+            let grade = |h: &[f64]| match &pieces {
+                Some(p) => p.grade(grid.vertices(), grid.triangles(), h, s),
+                None => gradation::grade(grid.vertices(), grid.triangles(), grid.topology(), h, s),
             };
             let (mut h, mut r) = grade(&h0);
             for _ in 0..CONTACT_ROUNDS {

@@ -423,3 +423,57 @@ fn lowering_a_sliver_never_goes_below_its_smallest_corner() {
     }
     assert_eq!(below, 0, "corners lowered below the smallest one");
 }
+
+/// Grading the pieces of a grid side by side gives the whole grid's field
+/// and report bit for bit: three bodies (two of them sharing a vertex, so
+/// one piece) with point-like minima that need every step, a body whose
+/// field is already graded, and a vertex on no triangle.
+#[test]
+fn pieces_grade_as_the_whole() {
+    use crate::test_shapes::unit_square;
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    let mut t: Vec<[u32; 3]> = Vec::new();
+    let mut add = |(sv, st): (Vec<[f64; 3]>, Vec<[u32; 3]>), shift: [f64; 3]| {
+        let o = v.len() as u32;
+        v.extend(
+            sv.into_iter()
+                .map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]),
+        );
+        t.extend(st.into_iter().map(|x| x.map(|i| i + o)));
+    };
+    add(unit_square(12, |x, y| 0.2 * x * y), [0.0; 3]);
+    add(unit_square(9, |_, _| 0.0), [3.0, 0.0, 0.0]);
+    add(unit_square(7, |x, _| 0.3 * x), [6.0, 0.0, 0.0]);
+    // A body touching the first at its corner (1, 1, 0.2): one piece with it.
+    let corner = v.iter().position(|p| *p == [1.0, 1.0, 0.2]).unwrap() as u32;
+    let o = v.len() as u32;
+    v.extend([[2.0, 1.0, 0.2], [1.0, 2.0, 0.2]]);
+    t.push([corner, o, o + 1]);
+    v.push([9.0, 9.0, 9.0]); // on no triangle
+    let topo = crate::mesh::Topology::build(v.len(), &t);
+    let s = 0.3;
+    let mut seed = 11;
+    let mut h0: Vec<f64> = v
+        .iter()
+        .map(|p| {
+            if p[0] >= 6.0 {
+                0.5
+            } else {
+                0.05 + crate::test_shapes::rng(&mut seed)
+            }
+        })
+        .collect();
+    h0[5] = 0.001;
+    h0[200] = 0.002;
+    let pieces = super::parts::Pieces::new(&v, &t).expect("several pieces");
+    assert_eq!(pieces.len(), 3);
+    for h0 in [h0.clone(), vec![0.4; v.len()]] {
+        let whole = super::grade(&v, &t, &topo, &h0, s);
+        let parts = pieces.grade(&v, &t, &h0, s);
+        let bits = |h: &[f64]| h.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&whole.0), bits(&parts.0));
+        assert_eq!(whole.1, parts.1);
+    }
+    let whole = super::grade(&v, &t, &topo, &h0, s);
+    assert!(whole.1.faces_fixed > 0 && whole.1.vertices_lowered > 0);
+}
