@@ -423,9 +423,11 @@ fn run(
 /// again. A level at scale s splits only what is longer than 4/3·s·L and
 /// lets a collapse of an edge shorter than 4/5·L make edges up to 4/3·s·L
 /// (still held to the surface by the unscaled fidelity tolerance), then
-/// flips and projects; levels s = 4, then 2. On a mesh without needles a
-/// level splits nothing, and its collapses only remove what the first
-/// iteration's would. Every part runs both (a per-part choice would make a
+/// flips and projects; levels s = 4, then 2. On a mesh already near its
+/// target a level splits nothing, and its collapses take the short edges
+/// the first iteration would take, and some it would refuse for the
+/// longer edges they make (which the iterations then split again). Every
+/// part runs both (a per-part choice would make a
 /// part's result depend on the rest of the mesh whenever parts are
 /// remeshed as one). O(F log F) per level.
 pub(crate) fn coarse_levels(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) {
