@@ -8,7 +8,7 @@ pub mod halfedge;
 mod restore;
 pub mod shape;
 pub(crate) mod stats;
-mod topology;
+pub(crate) mod topology;
 mod validate;
 pub mod weld;
 

@@ -430,7 +430,7 @@ fn run(
 /// part runs both (a per-part choice would make a
 /// part's result depend on the rest of the mesh whenever parts are
 /// remeshed as one). O(F log F) per level.
-pub(crate) fn coarse_levels(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) {
+fn coarse_levels(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) {
     for scale in [4.0, 2.0] {
         let level = Limits { scale, ..*lim };
         ops::split_long(mesh, reference, &level);
@@ -459,8 +459,7 @@ fn expected_faces(mesh: &HalfedgeMesh) -> f64 {
                 .iter()
                 .sum::<f64>()
                 / 3.0;
-            let n = mesh.face_normal2(f);
-            let area = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            let area = 0.5 * crate::geometry::norm(mesh.face_normal2(f));
             let faces = per_area * area / (l * l);
             if faces.is_finite() {
                 faces

@@ -101,9 +101,9 @@ fn parts_remeshed_apart_are_the_whole_remeshed() {
 }
 
 /// The parts' scheduling key predicts what remeshing makes: on a flat unit
-/// square (two input triangles) at L = 0.05, within a fifth of the faces
-/// the remesher writes, whatever the input's face count; a part without
-/// a finite target counts nothing.
+/// square of two input triangles at L = 0.05, exactly the area over an
+/// equilateral triangle's and within a fifth of the faces the remesher
+/// writes; a part without a finite target counts nothing.
 #[test]
 fn expected_faces_predicts_the_output() {
     use crate::mesh::halfedge::HalfedgeMesh;

@@ -33,6 +33,7 @@
 //! output does not depend on the thread count.
 
 use super::{grade_with, graded_already, max_face_slope, GradationReport};
+use crate::mesh::topology::{find, union};
 use crate::mesh::Topology;
 use rayon::prelude::*;
 
@@ -62,25 +63,9 @@ impl Pieces {
     pub fn new(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Option<Pieces> {
         let n = vertices.len();
         let mut parent: Vec<u32> = (0..n as u32).collect();
-        fn root(parent: &mut [u32], mut x: u32) -> u32 {
-            while parent[x as usize] != x {
-                let up = parent[parent[x as usize] as usize];
-                parent[x as usize] = up;
-                x = up;
-            }
-            x
-        }
         for t in triangles {
-            for &c in &t[1..] {
-                let (a, b) = (root(&mut parent, t[0]), root(&mut parent, c));
-                // The lower index becomes the root: labels do not depend on
-                // the order of the unions.
-                if a < b {
-                    parent[b as usize] = a;
-                } else if b < a {
-                    parent[a as usize] = b;
-                }
-            }
+            union(&mut parent, t[0], t[1]);
+            union(&mut parent, t[0], t[2]);
         }
         // Piece of each vertex on a triangle, numbered by lowest vertex.
         let mut on_triangle = vec![false; n];
@@ -96,7 +81,7 @@ impl Pieces {
             if !on_triangle[v] {
                 continue;
             }
-            let r = root(&mut parent, v as u32) as usize;
+            let r = find(&mut parent, v as u32) as usize;
             if piece_of_root[r] == u32::MAX {
                 piece_of_root[r] = count;
                 count += 1;
