@@ -63,10 +63,9 @@ print("|---|---:|---:|" + "---:|" * (len(stages) + 4))
 per_face = []
 for r in runs:
     rep = json.load(open(f"{out}/{r}/report.json"))
-    # The peak from report.json: `abgs run` resets the kernel's peak (VmHWM)
-    # before each stage to measure it alone, and that reset also lowers what
-    # /usr/bin/time reports at exit to the last stages' peak (kept only as a
-    # fallback for a report without one).
+    # The peak from report.json (the run's own VmHWM reading). /usr/bin/time
+    # is only a fallback for a report without one: binaries before commit
+    # 8c0179c reset VmHWM per stage, which lowered what it reported.
     wall, rss_kb = open(f"{out}/{r}.time").read().split()
     peak = (rep.get("memory") or {}).get("peak_rss_bytes") or 1024 * int(rss_kb)
     c, s = rep["counts"], rep["seconds"]

@@ -38,7 +38,7 @@ pub fn peak_rss_bytes() -> Option<u64> {
 }
 
 /// The resident set size now, in bytes (`None` where unknown).
-pub fn rss_bytes() -> Option<u64> {
+fn rss_bytes() -> Option<u64> {
     status_bytes("VmRSS:")
 }
 
@@ -108,12 +108,12 @@ impl Meter {
     /// Records the peak of the stage `name` that just ended and starts the
     /// next one.
     pub fn end_stage(&mut self, name: &str) {
-        let now = rss_bytes();
-        let peak = self.sampler.as_ref().map(|s| {
-            // The next stage starts at the current size.
-            let seen = s.stage_max.swap(now.unwrap_or(0), Ordering::Relaxed);
-            seen.max(now.unwrap_or(0))
-        });
+        let now = rss_bytes().unwrap_or(0);
+        // The next stage starts at the current size.
+        let peak = self
+            .sampler
+            .as_ref()
+            .map(|s| s.stage_max.swap(now, Ordering::Relaxed).max(now));
         // The kernel's mark and the sampled sizes are read from counters
         // kept apart (per CPU), so either can be a little ahead.
         self.overall = self.overall.max(peak_rss_bytes()).max(peak);
