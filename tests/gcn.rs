@@ -268,3 +268,40 @@ fn the_tail_goes_on_where_the_model_stops_and_keeps_the_field() {
     assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);
     assert_eq!(euler(&with.grid), 2);
 }
+
+#[test]
+fn reused_predictions_save_forward_passes_and_keep_the_field() {
+    use abgs::gcn::{embedded_model, Learned};
+    let g = sized_sphere(4);
+    let model = embedded_model().unwrap();
+    let run = |share: f64| {
+        let mut scorer = Learned::new(model);
+        scorer.stale_share = share;
+        let s = abgs::simplify::simplify_with(&g, &gcn_params(false), &mut scorer, None).unwrap();
+        (s, scorer.passes())
+    };
+    // Share 0: a pass whenever an edge changed, i.e. every iteration.
+    let (every, every_passes) = run(0.0);
+    let (reused, reused_passes) = run(abgs::gcn::scorer::STALE_SHARE);
+    assert!(every_passes >= every.report.iterations.len());
+    assert!(
+        reused_passes < every_passes,
+        "reuse {reused_passes} passes, every iteration {every_passes}"
+    );
+    let ep = abgs::metrics::EvalParams {
+        samples: 20_000,
+        hausdorff_samples: 20_000,
+        ..Default::default()
+    };
+    for s in [&every, &reused] {
+        let e = abgs::metrics::evaluate(&g, &s.grid, &ep).unwrap();
+        assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);
+        assert_eq!(euler(&s.grid), 2);
+    }
+    // Reuse is a cheaper ranking, not a coarser result.
+    let (a, b) = (
+        every.report.faces_out as f64,
+        reused.report.faces_out as f64,
+    );
+    assert!((a - b).abs() <= 0.2 * a, "{a} vs {b} faces");
+}

@@ -4,7 +4,7 @@
 #   seeded train / val / test sets) -> per part: dense grid, sizes, LBO-ABGS
 #   trajectory with exact labels (abgs dataset) -> training + ONNX export + checks.
 #
-# Usage: training/build_model.sh            (from anywhere; ~45 min on 2 cores)
+# Usage: training/build_model.sh            (from anywhere; 36 min on 2 cores plus the venv)
 #
 # Environment (all optional):
 #   ABGS_VENV   venv path (default training/.venv; reused if it exists)

@@ -680,6 +680,16 @@ def write_card(path, rec):
         f.write("\n".join(lines))
 
 
+def shown_path(x):
+    """A path as the card shows it: relative to the repository when inside it
+    (no machine's own absolute paths in the committed card), else unchanged."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    ax = os.path.abspath(x) if os.path.exists(x) or os.sep in x else x
+    if isinstance(ax, str) and ax.startswith(root + os.sep):
+        return os.path.relpath(ax, root)
+    return x
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--data", required=True)
@@ -823,7 +833,7 @@ def main(argv=None):
         if x in ("--description", "--build-info", "--quiet"):
             skip = x != "--quiet"
             continue
-        args_shown.append(x if " " not in x else f"'{x}'")
+        args_shown.append(shown_path(x) if " " not in x else f"'{x}'")
     cmd = " ".join(["python", "training/train.py"] + args_shown)
     rec = {
         "format": "gcn-abgs-model-1",
@@ -841,7 +851,7 @@ def main(argv=None):
                          "normalisation": {"node": dict(zip(
                              ["log1p", "lo", "hi", "mean", "std"], norm["node"])),
                              "edge": dict(zip(["log1p", "lo", "hi", "mean", "std"], norm["edge"]))}},
-        "data": {"dir": os.path.abspath(a.data), "split_method": how, "description": desc,
+        "data": {"dir": shown_path(os.path.abspath(a.data)), "split_method": how, "description": desc,
                  **{k: split_summary(data[k][0], split[k]) for k in ("train", "val", "test")}},
         "training": {"seed": a.seed, "epochs": a.epochs, "epochs_run": len(history),
                      "best_epoch": best_epoch, "lr": a.lr, "cap": a.cap,

@@ -22,6 +22,11 @@
 //!   `onnxruntime==1.31.1` wheel's `onnxruntime/capi/libonnxruntime.so.1.31.1`;
 //!   unset, `libonnxruntime.so` is searched by the system loader. Needs 1.24 or newer.
 //!
+//! On tract, a graph of at least [`FIXED_MIN_EDGES`] edges runs on a session opened
+//! for its sizes alone (N, E and K fixed in the ONNX file's declared shapes; module
+//! `fixed`): tract's vectorised element-wise kernels need sizes it can prove at
+//! optimisation time, and without them the model ran 2.4× slower.
+//!
 //! A test binary thus runs one backend through `ort`; both are checked against the
 //! same stored ONNX Runtime outputs (`testdata/fixture_expected.json`, 1e-4), and with
 //! the feature on, ONNX Runtime's outputs are also compared in-process to tract run
@@ -590,6 +595,12 @@ impl Model {
     /// One forward pass on an idle session (or a new one): the `pred` values,
     /// row-major, after checking their shape.
     fn run(&self, g: &GraphInputs) -> std::result::Result<Vec<f32>, String> {
+        if self.backend == Backend::Tract && g.n_edges >= fixed::FIXED_MIN_EDGES {
+            // One session for this graph's sizes (module `fixed`), then dropped.
+            let bytes = fixed::fixed_sizes(&self.bytes, g.n_nodes, g.n_edges, g.k)?;
+            let mut session = open_session(runtime(None).map_err(|e| e.to_string())?, &bytes)?;
+            return run_session(&mut session, g);
+        }
         let idle = || self.idle.lock().unwrap_or_else(|p| p.into_inner());
         let taken = idle().pop();
         let mut session = match taken {
@@ -670,5 +681,8 @@ fn trial_graph() -> GraphInputs {
     }
 }
 
+mod fixed;
 #[cfg(test)]
 mod tests;
+
+pub use fixed::FIXED_MIN_EDGES;

@@ -499,3 +499,40 @@ fn onnxruntime_loader_rejects_bad_libraries() {
     let e = load_onnxruntime_api(Path::new("libm.so.6")).unwrap_err();
     assert!(e.contains("not ONNX Runtime"), "{e}");
 }
+
+#[test]
+fn sessions_fixed_to_the_graph_sizes_agree_with_the_dynamic_one() {
+    // Large enough for Model::predict to take the fixed-size session on tract.
+    let g = grid_graph(48, 48, 8, 7);
+    assert!(g.n_edges >= FIXED_MIN_EDGES);
+    let rt = runtime(None).unwrap();
+    let mut dynamic = open_session(rt, FIXTURE).unwrap();
+    let want = run_session(&mut dynamic, &g).unwrap();
+    let got = fixture().predict(&g).unwrap();
+    for (w, p) in want.chunks_exact(TARGETS).zip(&got) {
+        for (a, b) in w.iter().zip(p) {
+            assert!((a - b).abs() <= 1e-5 * (1.0 + a.abs()), "{a} vs {b}");
+        }
+    }
+    // The edit itself: every N, E, K of the interface becomes a number, and
+    // bytes that are not ONNX are refused.
+    use prost::Message;
+    let bytes = fixed::fixed_sizes(FIXTURE, g.n_nodes, g.n_edges, g.k).unwrap();
+    let m = tract_onnx::pb::ModelProto::decode(&bytes[..]).unwrap();
+    let graph = m.graph.unwrap();
+    for v in graph.input.iter().chain(&graph.output) {
+        use tract_onnx::pb::tensor_shape_proto::dimension::Value;
+        use tract_onnx::pb::type_proto::Value as Type;
+        let Some(Type::TensorType(t)) = v.r#type.as_ref().unwrap().value.as_ref() else {
+            panic!("{} is not a tensor", v.name)
+        };
+        for d in &t.shape.as_ref().unwrap().dim {
+            assert!(
+                matches!(d.value, Some(Value::DimValue(_))),
+                "{}: {d:?}",
+                v.name
+            );
+        }
+    }
+    assert!(fixed::fixed_sizes(b"not an onnx model", 2, 1, 1).is_err());
+}
