@@ -530,7 +530,8 @@ fn own_element_count(mesh: &HalfedgeMesh) -> f64 {
 /// invalid parameters, a grid without sizes, or a model that cannot run.
 /// LBO-ABGS costs about O(I · (E log E + C · S log F)) for I iterations, C
 /// candidates estimated afresh and S samples per estimate; GCN-ABGS replaces
-/// the C · S log F term by one forward pass per iteration.
+/// the C · S log F term by forward passes of the model (at most one per
+/// iteration, reused while most of the grid is unchanged).
 pub fn simplify(
     grid: &Grid,
     params: &SimplifyParams,

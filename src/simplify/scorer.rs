@@ -18,11 +18,13 @@
 //!   with estimates kept until their neighbourhood changes; by default only
 //!   the candidates whose rings are still free when their batch comes up
 //!   are estimated ([`super::Selection`]).
-//! - `gcn::scorer::Learned` (GCN-ABGS): one forward pass of the embedded
-//!   graph network predicts every edge's two unit-free errors; only the
+//! - `gcn::scorer::Learned` (GCN-ABGS): a forward pass of the embedded
+//!   graph network predicts every edge's two unit-free errors (kept for the
+//!   following iterations where an edge's ring is unchanged); only the
 //!   placement and the cheap validity checks (link condition, normal turn,
 //!   angles, the removed vertex's distance) are computed, on the best
-//!   predictions. O(E·K·D² model + E log E + C·valence²).
+//!   predictions. O(E·K·D²) per model pass, O(E log E + C·valence²) per
+//!   iteration.
 //!
 //! Both give the same bits for any thread count: parallel work is collected
 //! in edge order and ranked with ties broken by edge index.
