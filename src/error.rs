@@ -1,6 +1,6 @@
 //! The crate-wide error type. Every fallible operation returns [`Result`].
 //!
-//! Each variant maps to one stable C status code (see [`crate::ffi::Status`]).
+//! Each variant maps to one stable C status code (see `crate::ffi::Status`).
 
 use std::path::Path;
 

@@ -11,7 +11,7 @@
 //!   [`abgs_status::ABGS_ERR_BUSY`] instead of racing;
 //! - nothing from C is trusted to be a valid Rust value: enumerations cross as
 //!   `uint32_t` with constants and are checked; every struct begins with
-//!   `struct_size` and grows by the one rule of [`versioned`].
+//!   `struct_size` and grows by the one rule of `versioned`.
 //!
 //! This is the only module with `unsafe` code.
 #![allow(non_camel_case_types)]

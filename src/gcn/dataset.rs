@@ -18,9 +18,9 @@
 //!
 //! Format: one safetensors file; tensor names are prefixed with the
 //! snapshot index (`"0/node_x"`, …), little-endian, row-major:
-//! `node_x` f32 [N,2], `edge_x` f32 [E,8], `edge_ends` i64 [E,2],
-//! `nbr_node` i64 [N,K], `nbr_edge` i64 [N,K], `nbr_mask` f32 [N,K],
-//! `target` f32 [E,2], `valid` u8 [E], `allow_rel` f32 [E], `y` f32 [E].
+//! `node_x` f32 \[N,2\], `edge_x` f32 \[E,8\], `edge_ends` i64 \[E,2\],
+//! `nbr_node` i64 \[N,K\], `nbr_edge` i64 \[N,K\], `nbr_mask` f32 \[N,K\],
+//! `target` f32 \[E,2\], `valid` u8 \[E\], `allow_rel` f32 \[E\], `y` f32 \[E\].
 //! Metadata: `format` = `abgs-dataset-1`, `snapshots`, `source`, `t_size`,
 //! `beta`, `clearance`, and per snapshot `"{s}/iteration"`, `"{s}/faces"`.
 //! Python reads it with `safetensors.numpy.load_file`.

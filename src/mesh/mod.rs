@@ -418,7 +418,7 @@ impl Grid {
     /// other bodies only on `true` triangles. Empty for a grid of one body.
     /// Computed once, on first use: O(F log F), deterministic; parallel
     /// unless first called on a rayon worker thread (see
-    /// [`on_rayon_worker`]).
+    /// `on_rayon_worker`).
     pub fn contact_faces(&self) -> &[bool] {
         self.contact_faces.get_or_init(|| {
             use rayon::prelude::*;

@@ -10,7 +10,7 @@
 //! each excluding the bodies found before: at most [`MAX_BODIES`]).
 //!
 //! On a grid under test `G` (the reference itself, or a candidate whose bodies
-//! are matched to the reference's by [`super::sheets::body_map`]), each body's
+//! are matched to the reference's by `super::sheets::body_map`), each body's
 //! size at `p` is its own interpolated size at its own closest point to `p`
 //! (the candidate body matched to that reference body; a body the candidate
 //! lost is left out), and the **disagreement** at `p` is `max h / min h − 1`

@@ -8,7 +8,7 @@
 //!   interpolated on the sample's own reference triangle, `h_c` a surface query
 //!   on the candidate;
 //! - **wrong-sheet share**: the share of those samples whose query lands on
-//!   another body or on a face turned away (see [`sheets`]);
+//!   another body or on a face turned away (see `sheets`);
 //! - **elements per background cell**: the estimated element count with the
 //!   candidate's sizes over the candidate's face count, the number a mesher's
 //!   user reads (how many mesh triangles one grid cell sizes);
@@ -199,7 +199,7 @@ pub fn evaluate(reference: &Grid, candidate: &Grid, params: &EvalParams) -> Resu
 /// area) on `reference` with `seed`: `h_r` interpolated at the point's exact
 /// barycentric coordinates on its own reference triangle, `h_c` the candidate's
 /// surface query ([`Grid::closest`]). Equal sizes give exactly 1. Also the
-/// share of those queries that land on the wrong sheet (see [`sheets`]; the
+/// share of those queries that land on the wrong sheet (see `sheets`; the
 /// contact distance is [`Grid::contact_gap`] of the reference).
 ///
 /// Errors when a grid has no sizes or triangles, when `samples` is 0, or when a

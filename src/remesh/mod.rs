@@ -10,7 +10,7 @@
 //! surface bends at half the curvature size `π / (κ · n_circle)` (optional).
 //!
 //! Before the iterations, two coarse levels at 4·L and 2·L
-//! ([`coarse_levels`]), so long input needles (CAD exports) are not split
+//! (`coarse_levels`), so long input needles (CAD exports) are not split
 //! into slivers at L that the collapses then remove again.
 //!
 //! Features (dihedral angle above 30°, boundaries, non-manifold edges) are kept
@@ -25,7 +25,7 @@
 //! Cost: O(F log F) per iteration (projection dominates). Parallel (rayon):
 //! the parts of the mesh (its bodies, once the build has cut touching ones
 //! apart) are remeshed side by side, largest expected output first
-//! ([`expected_faces`]), and within a part
+//! (`expected_faces`), and within a part
 //! relaxation and projection run in parallel; a part's topological passes
 //! are sequential, so a single large body gains only from the latter. The
 //! output does not depend on the thread count.

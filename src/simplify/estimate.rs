@@ -21,7 +21,7 @@ pub struct Limits {
     /// Largest size ratio allowed where bodies touch (`T_contact`, > 1): at
     /// a point lying on two bodies each body follows the agreed size within
     /// it, so the two agree within about `T_contact²` (see
-    /// [`super::target`]).
+    /// `super::target`).
     pub t_contact: f64,
     /// The size term of the distance envelope (see [`super::envelope`]).
     pub size_term: SizeTerm,

@@ -32,7 +32,7 @@
 //! **Contacts.** A vertex of a face with a sample lying on two bodies keeps
 //! its size (its unknown is held at 1 in a projected CG): each body is
 //! fitted on its own, and moving one side of an interface would break the
-//! agreement the collapses kept there ([`super::target`]).
+//! agreement the collapses kept there (`super::target`).
 //!
 //! **Bounds.** A fitted size stays within `[h⁰/T_size, h⁰·T_size]` of the
 //! size it replaces (the collapses' own tolerance), so a vertex that few

@@ -160,7 +160,7 @@ pub struct SimplifyParams {
     /// (`T_contact`, default [`DEFAULT_T_CONTACT`] = 1.2, the default
     /// `T_size`): each body follows the agreed (smaller) size there within
     /// it, so touching bodies agree within about `T_contact²` (see
-    /// [`target`]); tighter costs faces (see [`DEFAULT_T_CONTACT`]).
+    /// `target`); tighter costs faces (see [`DEFAULT_T_CONTACT`]).
     pub t_contact: f64,
     /// Fixed distance rule `Δd ≤ τ_d·h_loc` in place of the derived
     /// misprojection term (`None`, the default: `Δd ≤ ½·ln(T_size)·h / ln β`,
@@ -564,7 +564,7 @@ pub fn simplify_with(
     run_loop(grid, params, scorer, progress, None)
 }
 
-/// What [`run_loop`] shows an observer: the state before each iteration's
+/// What `run_loop` shows an observer: the state before each iteration's
 /// ranking, and once more at the end.
 pub type Observer<'o> = &'o mut dyn FnMut(&View) -> Result<()>;
 

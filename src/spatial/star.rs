@@ -114,7 +114,7 @@ impl StarMesh<'_> {
 
     /// The reach of every vertex (see the module doc): the distance to the
     /// nearest triangle not containing it whose label is one of its star's,
-    /// capped at [`REACH_CAP`] times the star's radius (its farthest corner),
+    /// capped at `REACH_CAP` times the star's radius (its farthest corner),
     /// less the rounding slack. A capped reach is still a lower bound; it
     /// leaves to the BVH only points several star radii off the surface
     /// (which the samples of a simplification and the queries near a grid
