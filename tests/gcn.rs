@@ -132,6 +132,15 @@ fn bits(g: &Grid) -> (Vec<[u64; 3]>, Vec<[u32; 3]>, Vec<u64>) {
     )
 }
 
+/// The evaluation of a simplified sphere against its dense grid.
+fn eval_params() -> abgs::metrics::EvalParams {
+    abgs::metrics::EvalParams {
+        samples: 20_000,
+        hausdorff_samples: 20_000,
+        ..Default::default()
+    }
+}
+
 fn gcn_params(verify: bool) -> SimplifyParams {
     SimplifyParams {
         method: Method::Gcn,
@@ -182,11 +191,7 @@ fn gcn_abgs_same_bits_on_one_and_two_threads() {
 #[test]
 fn gcn_abgs_simplifies_and_keeps_the_field() {
     let g = sized_sphere(4);
-    let ep = abgs::metrics::EvalParams {
-        samples: 20_000,
-        hausdorff_samples: 20_000,
-        ..Default::default()
-    };
+    let ep = eval_params();
     let lbo = simplify(&g, &SimplifyParams::default(), None).unwrap();
     for verify in [false, true] {
         let s = simplify(&g, &gcn_params(verify), None).unwrap();
@@ -259,11 +264,7 @@ fn the_tail_goes_on_where_the_model_stops_and_keeps_the_field() {
         with.report.faces_out,
         without.report.faces_out
     );
-    let ep = abgs::metrics::EvalParams {
-        samples: 20_000,
-        hausdorff_samples: 20_000,
-        ..Default::default()
-    };
+    let ep = eval_params();
     let e = abgs::metrics::evaluate(&g, &with.grid, &ep).unwrap();
     assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);
     assert_eq!(euler(&with.grid), 2);
@@ -288,11 +289,7 @@ fn reused_predictions_save_forward_passes_and_keep_the_field() {
         reused_passes < every_passes,
         "reuse {reused_passes} passes, every iteration {every_passes}"
     );
-    let ep = abgs::metrics::EvalParams {
-        samples: 20_000,
-        hausdorff_samples: 20_000,
-        ..Default::default()
-    };
+    let ep = eval_params();
     for s in [&every, &reused] {
         let e = abgs::metrics::evaluate(&g, &s.grid, &ep).unwrap();
         assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);

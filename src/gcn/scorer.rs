@@ -128,9 +128,10 @@ pub struct Learned<'m> {
     y: Vec<f64>,
     /// The iteration of the last forward pass (0 = none yet).
     predicted_at: u32,
-    /// Largest share of the live unlocked edges whose prediction may be
-    /// stale (their closed ring changed since the last forward pass) before
-    /// an iteration runs the model again (default [`STALE_SHARE`]; 0 runs
+    /// Largest share of the live edges (counted with the locked ones, which
+    /// are never candidates) whose prediction may be stale (an unlocked edge
+    /// whose closed ring changed since the last forward pass) before an
+    /// iteration runs the model again (default [`STALE_SHARE`]; 0 runs
     /// it every iteration).
     pub stale_share: f64,
 }
@@ -242,7 +243,7 @@ impl EdgeScorer for Learned<'_> {
         // Reuse: the last pass's predictions serve the edges whose closed
         // ring has not changed since, until too many have.
         let stale = self.stale_edges(view);
-        let live = mesh.edges().count().max(1);
+        let live = mesh.edge_count().max(1);
         if self.predicted_at == 0 || stale as f64 > self.stale_share * live as f64 {
             self.refresh(view)?;
         }

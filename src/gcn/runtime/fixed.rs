@@ -8,14 +8,15 @@
 //! and Mul of the model over \[N, K, D\] and \[E, D\] tensors ran element by
 //! element through a generic broadcasting loop: 47 % of GCN-ABGS's time on
 //! occt_crankarm. With the sizes fixed, the same graph runs 2.4× faster
-//! (occt_crankarm's dense grid, 86,979 edges: 455 ms → 185 ms, same output
-//! bits), for about 10–20 ms of parsing and optimising per session.
+//! (occt_crankarm's dense grid, 86,979 edges, tract run directly: 455 ms →
+//! 185 ms per pass, same output bits; the whole GCN-ABGS run 6.1 → 4.5 s),
+//! for about 10–20 ms of parsing and optimising per session.
 //!
 //! So [`super::Model::predict`] on the tract backend opens a session
 //! specialised to the graph when it has at least [`FIXED_MIN_EDGES`] edges,
 //! runs it once and drops it; smaller graphs use the pooled dynamic
-//! sessions. ONNX Runtime specialises at run time by itself and always uses
-//! the dynamic sessions. Which session runs depends on E alone, so the
+//! sessions. ONNX Runtime keeps the dynamic sessions (whether fixed sizes
+//! would speed it up was not measured). Which session runs depends on E alone, so the
 //! predictions stay the same bits run to run and for any thread count.
 //!
 //! Cost: O(model size) to decode, edit and encode the ONNX protobuf, plus
