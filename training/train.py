@@ -684,9 +684,8 @@ def shown_path(x):
     """A path as the card shows it: relative to the repository when inside it
     (no machine's own absolute paths in the committed card), else unchanged."""
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    ax = os.path.abspath(x) if os.path.exists(x) or os.sep in x else x
-    if isinstance(ax, str) and ax.startswith(root + os.sep):
-        return os.path.relpath(ax, root)
+    if os.sep in x and os.path.abspath(x).startswith(root + os.sep):
+        return os.path.relpath(os.path.abspath(x), root)
     return x
 
 
