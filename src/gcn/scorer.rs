@@ -18,13 +18,14 @@
 //!    accepted, and only those get a light exact check — the placement and
 //!    validity checks of the accurate estimate (link condition, feature
 //!    rules, normal turn, largest angle, the removed vertex's exact distance
-//!    to the new faces) and its size and distance test at one sample per new
-//!    triangle, the centroid ([`Limits::centroid_only`]), instead of a lattice
-//!    of at least 6; with `verify`, the full accurate estimate. An edge that
+//!    to the new faces) and its size and distance test on the coarsest
+//!    lattice, 6 samples per new triangle ([`Limits::light`],
+//!    [`estimate::LIGHT_DIVISIONS`]), instead of samples about `h_min/2`
+//!    apart (up to 105); with `verify`, the full accurate estimate. An edge that
 //!    fails frees its ring for the next round; rounds end at `n·|E|` accepted
 //!    edges or when no candidate is free. (Checking the whole pool first
 //!    wasted nine checks in ten on CAD grids, where the rings of the accepted
-//!    edges block most of the pool. Without the centroid samples, confident
+//!    edges block most of the pool. Without the light samples, confident
 //!    mistakes of the model at the end of a run went through: on
 //!    occt_crankarm size deviation max 3.4 and −9.8 % elements against
 //!    LBO-ABGS's 1.24 and −1 %.)
@@ -296,7 +297,7 @@ impl Learned<'_> {
         let p = view.params;
         // Stage 1: the model's choices (ŷ < T_score), light checks.
         let light = Limits {
-            centroid_only: !p.verify,
+            light: !p.verify,
             ..*view.lim
         };
         let first = self.stage(view, y, f64::NEG_INFINITY, p.t_score, &light);
@@ -306,7 +307,7 @@ impl Learned<'_> {
         // Stage 2, the tail: the model only ranks (T_score ≤ ŷ < 1), the
         // accurate estimate decides.
         let exact = Limits {
-            centroid_only: false,
+            light: false,
             ..*view.lim
         };
         let tail = self.stage(view, y, p.t_score, TAIL_SCORE, &exact);

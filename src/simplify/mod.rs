@@ -272,7 +272,7 @@ impl SimplifyParams {
             max_distance: self.max_distance.unwrap_or(f64::INFINITY),
             cos_turn: self.max_normal_turn_deg.to_radians().cos(),
             max_angle_deg: self.max_angle_deg,
-            centroid_only: false,
+            light: false,
         }
     }
 }
