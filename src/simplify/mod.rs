@@ -704,3 +704,56 @@ pub fn edge_scores(grid: &Grid, params: &SimplifyParams) -> Result<Vec<EdgeScore
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::BuildOptions;
+    use crate::test_shapes::unit_square;
+
+    /// The light check (GCN-ABGS's check of the model's choices) is the
+    /// accurate estimate sampled on the coarsest lattice
+    /// ([`estimate::LIGHT_DIVISIONS`]): the same estimate, bit for bit, on
+    /// every edge where the sizes are large against the new triangles (the
+    /// full lattice is that one too), and a different one on some edges
+    /// where they are small (the full lattice is then denser).
+    #[test]
+    fn light_check_is_the_accurate_estimate_on_the_coarsest_lattice() {
+        let opts = BuildOptions {
+            weld_relative_tolerance: None,
+            orient: false,
+        };
+        for (h, same) in [(10.0, true), (0.01, false)] {
+            let (v, t) = unit_square(12, |x, y| 0.05 * (3.0 * x).sin() * (2.0 * y).cos());
+            let s = v
+                .iter()
+                .map(|p| h * (1.0 + 0.5 * p[0] + 0.3 * p[1]))
+                .collect();
+            let grid = Grid::from_arrays(v, t, Some(s), &opts).expect("valid sheet");
+            let params = SimplifyParams::default();
+            let (mesh, parts) = setup(&grid, &params).expect("target");
+            let target = parts.target(&grid);
+            let full = params.limits();
+            let light = Limits {
+                light: true,
+                ..full
+            };
+            let (mut edges, mut differ) = (0, 0);
+            for e in mesh.edges() {
+                let a = estimate::estimate(&mesh, &target, e, &full, f64::INFINITY);
+                let b = estimate::estimate(&mesh, &target, e, &light, f64::INFINITY);
+                // Debug prints each f64 so that it reads back to the same
+                // bits, and NaN (an invalid estimate's) equal to itself.
+                let (a, b) = (format!("{a:?}"), format!("{b:?}"));
+                edges += 1;
+                if same {
+                    assert_eq!(a, b, "h = {h}, edge {e}");
+                } else if a != b {
+                    differ += 1;
+                }
+            }
+            assert!(edges > 300, "{edges} edges");
+            assert!(same || differ > 0, "h = {h}: no estimate differs");
+        }
+    }
+}
