@@ -141,6 +141,28 @@ fn eval_params() -> abgs::metrics::EvalParams {
     }
 }
 
+/// GCN-ABGS (defaults, no verify) on `g` with the embedded model, its scorer
+/// set up by `configure`; the result and what `count` reads off the scorer
+/// afterwards.
+fn run_learned(
+    g: &Grid,
+    configure: impl FnOnce(&mut abgs::gcn::Learned),
+    count: impl FnOnce(&abgs::gcn::Learned) -> usize,
+) -> (abgs::simplify::Simplified, usize) {
+    let mut scorer = abgs::gcn::Learned::new(abgs::gcn::embedded_model().unwrap());
+    configure(&mut scorer);
+    let s = abgs::simplify::simplify_with(g, &gcn_params(false), &mut scorer, None).unwrap();
+    (s, count(&scorer))
+}
+
+/// `out`, simplified from the sized sphere `g`, keeps its field (size
+/// deviation p95 < 1.2) and stays a closed sphere (Euler characteristic 2).
+fn keeps_the_field(g: &Grid, out: &Grid) {
+    let e = abgs::metrics::evaluate(g, out, &eval_params()).unwrap();
+    assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);
+    assert_eq!(euler(out), 2);
+}
+
 fn gcn_params(verify: bool) -> SimplifyParams {
     SimplifyParams {
         method: Method::Gcn,
@@ -243,15 +265,8 @@ fn a_model_that_cannot_run_is_an_error() {
 
 #[test]
 fn the_tail_goes_on_where_the_model_stops_and_keeps_the_field() {
-    use abgs::gcn::{embedded_model, Learned};
     let g = sized_sphere(4);
-    let model = embedded_model().unwrap();
-    let run = |tail: bool| {
-        let mut scorer = Learned::new(model);
-        scorer.tail = tail;
-        let s = abgs::simplify::simplify_with(&g, &gcn_params(false), &mut scorer, None).unwrap();
-        (s, scorer.tail_checks())
-    };
+    let run = |tail: bool| run_learned(&g, |s| s.tail = tail, |s| s.tail_checks());
     let (without, no_checks) = run(false);
     let (with, checks) = run(true);
     assert_eq!(no_checks, 0);
@@ -264,23 +279,13 @@ fn the_tail_goes_on_where_the_model_stops_and_keeps_the_field() {
         with.report.faces_out,
         without.report.faces_out
     );
-    let ep = eval_params();
-    let e = abgs::metrics::evaluate(&g, &with.grid, &ep).unwrap();
-    assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);
-    assert_eq!(euler(&with.grid), 2);
+    keeps_the_field(&g, &with.grid);
 }
 
 #[test]
 fn reused_predictions_save_forward_passes_and_keep_the_field() {
-    use abgs::gcn::{embedded_model, Learned};
     let g = sized_sphere(4);
-    let model = embedded_model().unwrap();
-    let run = |share: f64| {
-        let mut scorer = Learned::new(model);
-        scorer.stale_share = share;
-        let s = abgs::simplify::simplify_with(&g, &gcn_params(false), &mut scorer, None).unwrap();
-        (s, scorer.passes())
-    };
+    let run = |share: f64| run_learned(&g, |s| s.stale_share = share, |s| s.passes());
     // Share 0: a pass whenever an edge changed, i.e. every iteration.
     let (every, every_passes) = run(0.0);
     let (reused, reused_passes) = run(abgs::gcn::scorer::STALE_SHARE);
@@ -289,11 +294,8 @@ fn reused_predictions_save_forward_passes_and_keep_the_field() {
         reused_passes < every_passes,
         "reuse {reused_passes} passes, every iteration {every_passes}"
     );
-    let ep = eval_params();
     for s in [&every, &reused] {
-        let e = abgs::metrics::evaluate(&g, &s.grid, &ep).unwrap();
-        assert!(e.size_deviation.p95 < 1.2, "{}", e.size_deviation.p95);
-        assert_eq!(euler(&s.grid), 2);
+        keeps_the_field(&g, &s.grid);
     }
     // Reuse is a cheaper ranking, not a coarser result.
     let (a, b) = (
