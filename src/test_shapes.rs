@@ -69,3 +69,24 @@ pub(crate) fn canonical_triangles(v: &[[f64; 3]], t: &[[u32; 3]]) -> Vec<[[u64; 
     s.sort_unstable();
     s
 }
+
+/// `n` random small triangles (sides up to 0.05) in the unit cube, three
+/// vertices of their own each (a soup: no shared vertices).
+pub(crate) fn triangle_soup(n: usize, seed: u64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut v = Vec::new();
+    let mut t = Vec::new();
+    for i in 0..n {
+        let c = [rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()];
+        for _ in 0..3 {
+            v.push([
+                c[0] + 0.05 * rng.gen::<f64>(),
+                c[1] + 0.05 * rng.gen::<f64>(),
+                c[2] + 0.05 * rng.gen::<f64>(),
+            ]);
+        }
+        t.push([3 * i as u32, 3 * i as u32 + 1, 3 * i as u32 + 2]);
+    }
+    (v, t)
+}

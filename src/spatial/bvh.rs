@@ -3,12 +3,17 @@
 //! corners copied into leaf order so a leaf is one contiguous read.
 //!
 //! Build: O(F log F) time, parallel over subtrees. Memory: 64 bytes per node
-//! (one cache line; about 0.6 nodes per triangle) plus 76 bytes per triangle.
+//! (one cache line; about 0.6 nodes per triangle) plus 76 bytes per triangle,
+//! plus the wide view's.
 //!
 //! Closest-point query: exact (f64 point–triangle distance), ties broken by the
 //! lowest triangle index, so the answer depends only on the point — never on the
 //! traversal order or a hint. Expected O(log F) for points near the surface.
+//! The closest-point searches descend a 4-wide view of this tree with f32
+//! boxes rounded outward (module `wide`, about 20 more bytes per triangle);
+//! the range searches and the node-pruned search descend the binary nodes.
 
+use super::wide::WideBvh;
 use crate::geometry::{closest_point_triangle, Aabb, ClosestPoint};
 use arrayvec::ArrayVec;
 
@@ -59,6 +64,9 @@ pub struct Bvh {
     pub triangle_prim: Vec<u32>,
     /// Largest absolute coordinate of the root box (scale of rounding errors).
     pub coord_scale: f64,
+    /// The 4-wide view the closest-point searches descend (derived from
+    /// `nodes`; see [`super::wide`]).
+    pub(super) wide: WideBvh,
 }
 
 /// Where a search reads the corners of a primitive slot (leaf order): the
@@ -77,13 +85,13 @@ impl Corners for [[[f64; 3]; 3]] {
 }
 
 /// Best candidate of a closest-point search.
-struct Best {
+pub(super) struct Best {
     tri: u32,
     cp: ClosestPoint,
     /// Squared distance of the best candidate (or the initial bound).
     d2: f64,
     /// Boxes farther than this (squared) are pruned: `d2` plus rounding slack.
-    limit: f64,
+    pub(super) limit: f64,
     /// Rounding allowance of squared distances (see [`Bvh::pad`]).
     pad: f64,
 }
@@ -106,7 +114,7 @@ impl Best {
     /// Keeps `cp` (on triangle `tri`) if it is closer, or equally close with a
     /// lower triangle index.
     #[inline(always)]
-    fn offer(&mut self, tri: u32, cp: ClosestPoint) {
+    pub(super) fn offer(&mut self, tri: u32, cp: ClosestPoint) {
         if cp.dist2 < self.d2 || (cp.dist2 == self.d2 && tri < self.tri) {
             if cp.dist2 != self.d2 {
                 self.limit = padded(cp.dist2, self.pad);
@@ -115,6 +123,14 @@ impl Best {
             self.tri = tri;
             self.cp = cp;
         }
+    }
+
+    /// The answer: the best candidate, if any.
+    pub(super) fn hit(&self) -> Option<ClosestHit> {
+        (self.tri != u32::MAX).then_some(ClosestHit {
+            triangle: self.tri,
+            closest: self.cp,
+        })
     }
 }
 
@@ -172,6 +188,7 @@ impl Bvh {
             triangle_prim[t as usize] = slot as u32;
         }
         Bvh {
+            wide: WideBvh::build(&nodes),
             nodes,
             prim_triangle,
             prim_corners,
@@ -186,6 +203,7 @@ impl Bvh {
             + self.prim_triangle.len() * 4
             + self.triangle_prim.len() * 4
             + self.prim_corners.len() * std::mem::size_of::<[[f64; 3]; 3]>()
+            + self.wide.memory_bytes()
     }
 
     /// Depth of the tree (1 for a single leaf).
@@ -224,14 +242,7 @@ impl Bvh {
         hint: Option<u32>,
         keep: impl Fn(u32) -> bool,
     ) -> Option<ClosestHit> {
-        self.search(
-            p,
-            hint,
-            f64::INFINITY,
-            keep,
-            |_| true,
-            &self.prim_corners[..],
-        )
+        self.search_wide(p, hint, f64::INFINITY, keep, &self.prim_corners[..])
     }
 
     /// [`Bvh::closest_filtered`] restricted to distances below `max_distance`
@@ -244,12 +255,11 @@ impl Bvh {
         max_distance: f64,
         keep: impl Fn(u32) -> bool,
     ) -> Option<ClosestHit> {
-        self.search(
+        self.search_wide(
             p,
             None,
             max_distance * max_distance,
             keep,
-            |_| true,
             &self.prim_corners[..],
         )
     }
@@ -296,13 +306,35 @@ impl Bvh {
         hint: Option<u32>,
         corners: &impl Corners,
     ) -> Option<ClosestHit> {
-        self.search(p, hint, f64::INFINITY, |_| true, |_| true, corners)
+        self.search_wide(p, hint, f64::INFINITY, |_| true, corners)
+    }
+
+    /// The start of a search at `p` from the bound `bound2` (squared): the
+    /// `hint` triangle offered first when it is in range and accepted.
+    #[inline(always)]
+    pub(super) fn seed(
+        &self,
+        p: [f64; 3],
+        hint: Option<u32>,
+        bound2: f64,
+        keep: &impl Fn(u32) -> bool,
+        corners: &(impl Corners + ?Sized),
+    ) -> Best {
+        let mut best = Best::new(p, bound2, self.pad(&p));
+        // In range first: `keep` may index by triangle.
+        if let Some(h) = hint.filter(|&h| (h as usize) < self.triangle_prim.len() && keep(h)) {
+            let c = corners.corners(self.triangle_prim[h as usize] as usize);
+            best.offer(h, closest_point_triangle(p, c[0], c[1], c[2]));
+        }
+        best
     }
 
     /// Branch and bound from the bound `bound2` (squared distance), seeded by
     /// `hint`: top-down from the root, nearer child first, the corners of
-    /// each primitive slot read from `corners`.
-    fn search(
+    /// each primitive slot read from `corners`. The binary descent, for the
+    /// searches that prune by node ([`Bvh::closest_filtered_within_pruned`]);
+    /// the others descend the wide tree ([`super::wide`]), same answers.
+    pub(super) fn search(
         &self,
         p: [f64; 3],
         hint: Option<u32>,
@@ -314,19 +346,11 @@ impl Bvh {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best = Best::new(p, bound2, self.pad(&p));
-        // In range first: `keep` may index by triangle.
-        if let Some(h) = hint.filter(|&h| (h as usize) < self.triangle_prim.len() && keep(h)) {
-            let c = corners.corners(self.triangle_prim[h as usize] as usize);
-            best.offer(h, closest_point_triangle(p, c[0], c[1], c[2]));
-        }
+        let mut best = self.seed(p, hint, bound2, &keep, corners);
         if self.nodes[0].bbox.distance2(&p) <= best.limit {
             self.descend(&p, &mut best, &keep, &keep_node, corners);
         }
-        (best.tri != u32::MAX).then_some(ClosestHit {
-            triangle: best.tri,
-            closest: best.cp,
-        })
+        best.hit()
     }
 
     /// Some triangle whose (computed) squared distance to `p` is at most `r2`,
@@ -423,7 +447,7 @@ impl Bvh {
     /// the largest distance from `p` to the root box, `(√d2 + s)² ≤ d2 + s(2R + s)`,
     /// the returned `s(2R + s)`.
     #[inline]
-    fn pad(&self, p: &[f64; 3]) -> f64 {
+    pub(super) fn pad(&self, p: &[f64; 3]) -> f64 {
         let s = self.rounding_scale(p);
         let b = &self.nodes[0].bbox;
         let mut r2 = 0.0;
@@ -445,8 +469,21 @@ impl Bvh {
         corners: &(impl Corners + ?Sized),
     ) {
         let n = &self.nodes[leaf];
-        let s = n.start as usize;
-        for slot in s..s + n.count as usize {
+        self.scan_slots(n.start as usize, n.count as usize, p, best, keep, corners);
+    }
+
+    /// Offers the accepted triangles of the primitive slots `s..s + count`.
+    #[inline]
+    pub(super) fn scan_slots(
+        &self,
+        s: usize,
+        count: usize,
+        p: &[f64; 3],
+        best: &mut Best,
+        keep: &impl Fn(u32) -> bool,
+        corners: &(impl Corners + ?Sized),
+    ) {
+        for slot in s..s + count {
             let tri = self.prim_triangle[slot];
             if keep(tri) {
                 let c = corners.corners(slot);
@@ -702,25 +739,8 @@ fn sah_split(prims: &mut [Prim], bbox: &Aabb, cbox: &Aabb, axis: usize) -> Optio
 mod tests {
     use super::*;
     use crate::geometry::dist2;
+    use crate::test_shapes::triangle_soup as random_soup;
     use rand::{Rng, SeedableRng};
-
-    fn random_soup(n: usize, seed: u64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let mut v = Vec::new();
-        let mut t = Vec::new();
-        for i in 0..n {
-            let c = [rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()];
-            for _ in 0..3 {
-                v.push([
-                    c[0] + 0.05 * rng.gen::<f64>(),
-                    c[1] + 0.05 * rng.gen::<f64>(),
-                    c[2] + 0.05 * rng.gen::<f64>(),
-                ]);
-            }
-            t.push([3 * i as u32, 3 * i as u32 + 1, 3 * i as u32 + 2]);
-        }
-        (v, t)
-    }
 
     #[test]
     fn closest_matches_brute_force_with_and_without_hint() {

@@ -7,6 +7,7 @@ mod forest;
 mod layout;
 mod ray;
 mod star;
+mod wide;
 
 pub use bvh::{Bvh, ClosestHit, Node, MAX_DEPTH, MIXED_LABEL};
 pub use forest::LabelForest;
