@@ -72,7 +72,7 @@ impl Grid {
         }
         let hit = self
             .bvh()
-            .closest(p, hint)
+            .closest_wide(p, hint)
             .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;

@@ -113,7 +113,7 @@ impl Bvh {
         }
         let coord_scale = coord_scale(&built[0].bbox);
         Ok(Bvh {
-            wide: super::wide::WideBvh::build(&built),
+            wide: Default::default(),
             nodes: built,
             prim_triangle,
             prim_corners,
