@@ -1,4 +1,4 @@
-//! The 4-wide view of a [`Bvh`] that its closest-point searches descend:
+//! The 4-wide view of a [`Bvh`] that [`Bvh::closest_wide`] descends:
 //! each node holds the boxes of up to four children in f32, rounded outward,
 //! so one node visit tests four boxes in a few vector instructions and reads
 //! two cache lines, where the binary tree tests two boxes per node in f64.
@@ -9,8 +9,9 @@
 //! holds four or only leaves remain. Each lane is then either another wide
 //! node or a binary leaf (a run of primitive slots): the leaves, the
 //! primitive order and the corners are the binary tree's, so the triangle
-//! tests are unchanged. Lanes that would need a leaf opened stay empty, so
-//! there are 0.25–0.35 wide nodes per triangle (against 1.1–1.5 binary
+//! tests are unchanged. A node whose lanes are all leaves keeps its empty
+//! lanes (leaves are not opened), so there are 0.25–0.35 wide nodes per
+//! triangle (against 1.1–1.5 binary
 //! nodes with the SAH's small leaves): 128 bytes each, 33–45 bytes per
 //! triangle (measured on a random soup and a smooth plate). Built in
 //! O(nodes), no allocation beyond the node array; depth at most the binary
@@ -114,6 +115,38 @@ fn pow2_floor(x: f64) -> f64 {
     f64::from_bits(x.to_bits() & 0x7ff0_0000_0000_0000)
 }
 
+/// The binary nodes behind the lanes of the wide node made for binary node
+/// `bi`: `bi` itself for a leaf; else its two children, then repeatedly the
+/// inner lane with the largest box (the first on ties) replaced by its two
+/// children, until there are [`WIDTH`] lanes or only leaves. O(1).
+fn lanes(nodes: &[Node], bi: usize) -> ArrayVec<usize, WIDTH> {
+    let mut lanes: ArrayVec<usize, WIDTH> = ArrayVec::new();
+    if nodes[bi].is_leaf() {
+        lanes.push(bi);
+        return lanes;
+    }
+    lanes.push(bi + 1);
+    lanes.push(nodes[bi].start as usize);
+    while lanes.len() < WIDTH {
+        let open = lanes
+            .iter()
+            .enumerate()
+            .filter(|(_, &n)| !nodes[n].is_leaf())
+            .fold(None, |acc: Option<(usize, f64)>, (i, &n)| {
+                let a = nodes[n].bbox.area();
+                match acc {
+                    Some((_, best)) if best >= a => acc,
+                    _ => Some((i, a)),
+                }
+            });
+        let Some((i, _)) = open else { break };
+        let n = lanes[i];
+        lanes[i] = n + 1;
+        lanes.insert(i + 1, nodes[n].start as usize);
+    }
+    lanes
+}
+
 impl WideBvh {
     /// Collapses the binary `nodes` (root first, depth first, as [`Bvh`]
     /// stores them) into the wide tree. O(nodes).
@@ -148,31 +181,7 @@ impl WideBvh {
     /// Appends the wide node for binary node `bi` (and, after it, its wide
     /// descendants, depth first); returns its index.
     fn collapse(&mut self, nodes: &[Node], bi: usize) -> u32 {
-        let mut lanes: ArrayVec<usize, WIDTH> = ArrayVec::new();
-        if nodes[bi].is_leaf() {
-            lanes.push(bi);
-        } else {
-            lanes.push(bi + 1);
-            lanes.push(nodes[bi].start as usize);
-            while lanes.len() < WIDTH {
-                // The inner lane with the largest box (first on ties) opens.
-                let open = lanes
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, &n)| !nodes[n].is_leaf())
-                    .fold(None, |acc: Option<(usize, f64)>, (i, &n)| {
-                        let a = nodes[n].bbox.area();
-                        match acc {
-                            Some((_, best)) if best >= a => acc,
-                            _ => Some((i, a)),
-                        }
-                    });
-                let Some((i, _)) = open else { break };
-                let n = lanes[i];
-                lanes[i] = n + 1;
-                lanes.insert(i + 1, nodes[n].start as usize);
-            }
-        }
+        let lanes = lanes(nodes, bi);
         let me = self.nodes.len();
         self.nodes.push(WideNode::EMPTY);
         for (i, &n) in lanes.iter().enumerate() {
@@ -318,39 +327,15 @@ mod tests {
     use crate::test_shapes::triangle_soup;
     use rand::{Rng, SeedableRng};
 
-    /// The binary tree's f64 box of every wide lane, found by walking both.
+    /// Every wide lane's f32 box holds its binary node's f64 box, and every
+    /// primitive slot is in exactly one leaf lane (walking both trees).
     fn lanes_hold_their_binary_boxes(bvh: &Bvh) {
         // Every primitive slot is in exactly one leaf lane.
         let mut covered = vec![0u32; bvh.prim_triangle.len()];
         let w = bvh.wide();
         let mut stack = vec![(0usize, 0usize)];
         while let Some((wi, bi)) = stack.pop() {
-            // Recover the binary nodes behind the lanes in the build's order.
-            let mut lanes = vec![];
-            if bvh.nodes[bi].is_leaf() {
-                lanes.push(bi);
-            } else {
-                lanes.extend([bi + 1, bvh.nodes[bi].start as usize]);
-                while lanes.len() < WIDTH {
-                    let Some(i) = (0..lanes.len())
-                        .filter(|&i| !bvh.nodes[lanes[i]].is_leaf())
-                        .fold(None, |acc: Option<usize>, i| match acc {
-                            Some(b)
-                                if bvh.nodes[lanes[b]].bbox.area()
-                                    >= bvh.nodes[lanes[i]].bbox.area() =>
-                            {
-                                acc
-                            }
-                            _ => Some(i),
-                        })
-                    else {
-                        break;
-                    };
-                    let n = lanes[i];
-                    lanes[i] = n + 1;
-                    lanes.insert(i + 1, bvh.nodes[n].start as usize);
-                }
-            }
+            let lanes = lanes(&bvh.nodes, bi);
             let node = &w.nodes[wi];
             for i in 0..WIDTH {
                 let Some(&bn) = lanes.get(i) else {
