@@ -172,7 +172,9 @@ typedef struct {
   // Bounding-box diagonal.
   double diagonal;
   // Heap bytes held by the grid and its BVH (from its first size query
-  // on, with the BVH's 4-wide query view: 33–45 bytes per triangle more).
+  // on, with the BVH's 4-wide query view: 33–45 bytes per triangle more;
+  // from its first hinted or batch query on, with the hinted search's
+  // prism table: 16 bytes per triangle more).
   uint64_t memory_bytes;
 } abgs_grid_stats;
 
@@ -808,7 +810,10 @@ abgs_status abgs_query_size(const abgs_grid *grid, const double *point, double *
 // As `abgs_query_size`, seeded by `*hint` (a triangle index from an earlier
 // query, or `ABGS_NO_HINT`; any value is safe) and updating it to the triangle
 // of this answer. The size equals `abgs_query_size`'s bit for bit; only the time
-// changes (coherent queries, as an advancing front makes, are much faster).
+// changes: a point near the surface a few triangles from its hint (as an
+// advancing front queries) is answered by a certified walk without a tree
+// descent. The grid's first hinted query builds the table that walk reads
+// (O(F log F), parallel, 16 bytes per triangle).
 //
 // # Safety
 // Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated

@@ -47,7 +47,9 @@ pub struct abgs_grid_stats {
     /// Bounding-box diagonal.
     pub diagonal: f64,
     /// Heap bytes held by the grid and its BVH (from its first size query
-    /// on, with the BVH's 4-wide query view: 33–45 bytes per triangle more).
+    /// on, with the BVH's 4-wide query view: 33–45 bytes per triangle more;
+    /// from its first hinted or batch query on, with the hinted search's
+    /// prism table: 16 bytes per triangle more).
     pub memory_bytes: u64,
 }
 

@@ -62,7 +62,10 @@ pub unsafe extern "C" fn abgs_query_size(
 /// As `abgs_query_size`, seeded by `*hint` (a triangle index from an earlier
 /// query, or `ABGS_NO_HINT`; any value is safe) and updating it to the triangle
 /// of this answer. The size equals `abgs_query_size`'s bit for bit; only the time
-/// changes (coherent queries, as an advancing front makes, are much faster).
+/// changes: a point near the surface a few triangles from its hint (as an
+/// advancing front queries) is answered by a certified walk without a tree
+/// descent. The grid's first hinted query builds the table that walk reads
+/// (O(F log F), parallel, 16 bytes per triangle).
 ///
 /// # Safety
 /// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated

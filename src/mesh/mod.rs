@@ -88,6 +88,10 @@ pub struct Grid {
     /// [`crate::spatial::MIXED_LABEL`]. Computed on first use
     /// ([`Grid::node_bodies`]).
     node_bodies: std::sync::OnceLock<Vec<u32>>,
+    /// The certified hinted search's table (per BVH slot: the faces across
+    /// its edges and its prism clearance). Computed on first use
+    /// ([`Grid::prisms`]).
+    prisms: std::sync::OnceLock<crate::spatial::Prisms>,
 }
 
 /// The arrays of a grid once checked, before its adjacency and hierarchy.
@@ -286,6 +290,7 @@ impl Grid {
             contact_faces: std::sync::OnceLock::new(),
             contact_lists: std::sync::OnceLock::new(),
             node_bodies: std::sync::OnceLock::new(),
+            prisms: std::sync::OnceLock::new(),
         };
         if let Some(s) = sizes {
             grid.install_sizes(s);
@@ -489,6 +494,26 @@ impl Grid {
     pub(crate) fn node_bodies(&self) -> &[u32] {
         self.node_bodies
             .get_or_init(|| self.bvh.node_labels(&self.topology.face_body))
+    }
+
+    /// The grid as the certified hinted search reads it
+    /// ([`crate::spatial::PrismMesh`]).
+    pub(crate) fn prism_mesh(&self) -> crate::spatial::PrismMesh<'_> {
+        crate::spatial::PrismMesh {
+            face_edges: &self.topology.face_edges,
+            edge_face_offsets: &self.topology.edge_face_offsets,
+            edge_faces: &self.topology.edge_faces,
+            bvh: &self.bvh,
+        }
+    }
+
+    /// The certified hinted search's table
+    /// ([`crate::spatial::PrismMesh::build`]), which lets a hinted query
+    /// skip the descent. Computed once, on first use: O(F log F), parallel
+    /// unless first reached from a rayon worker; 16 bytes per triangle.
+    pub(crate) fn prisms(&self) -> &crate::spatial::Prisms {
+        self.prisms
+            .get_or_init(|| self.prism_mesh().build(on_rayon_worker()))
     }
 
     /// Bounding box of the vertices.

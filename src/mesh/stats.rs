@@ -115,7 +115,8 @@ impl Grid {
             + topo.face_edges.len() * 12
             + topo.vertex_face_offsets.len() * 4
             + topo.vertex_faces.len() * 4
-            + topo.face_body.len() * 4;
+            + topo.face_body.len() * 4
+            + self.prisms.get().map_or(0, |p| p.memory_bytes());
         GridStats {
             vertices: self.vertices().len(),
             triangles: self.triangles().len(),

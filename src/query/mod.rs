@@ -19,8 +19,13 @@
 //!   on a grid of several bodies it costs one more bounded search (radius
 //!   `c`) per query, and nothing on one body. Volume queries (a minimum over
 //!   the whole surface) satisfy it by construction.
-//! - **hinted**: the same answer, with the search bound seeded by a triangle the
-//!   caller kept from a nearby query (advancing fronts query neighbours).
+//! - **hinted**: the same answer, from a triangle the caller kept from a
+//!   nearby query (advancing fronts query neighbours): a short walk across
+//!   edges to the triangle whose prism holds the point, and a certificate
+//!   that no other triangle can be as near (module
+//!   [`crate::spatial::PrismMesh`]'s doc) answer most such queries with one
+//!   exact point–triangle test; the others descend the BVH with their bound
+//!   seeded by that triangle.
 //! - **batch**: many points in parallel (rayon), each answer identical to the
 //!   single query, whatever the thread count; a scattered batch is answered
 //!   along a Morton curve (module `order`), for warmer caches.
@@ -64,16 +69,26 @@ const BATCH_CHUNK: usize = 256;
 impl Grid {
     /// Closest point and interpolated size at `p`, with an optional triangle hint
     /// (ignored when out of range). Errors only on a point that is not finite or
-    /// beyond [`MAX_COORDINATE`].
+    /// beyond [`MAX_COORDINATE`]. A hint changes the time, never the answer:
+    /// the first hinted query builds the grid's prism table (O(F log F),
+    /// parallel, 16 bytes per triangle), then a point near the surface a few
+    /// triangles from its hint is answered in O(1) by a certified walk
+    /// ([`crate::spatial::Prisms::closest_from`]), any other by the BVH.
     /// Expected O(log F).
     pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Result<QueryHit> {
         if !is_coordinate3(p) {
             return Err(non_finite_point(p));
         }
-        let hit = self
-            .bvh()
-            .closest_wide(p, hint)
-            .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
+        let hit = match hint {
+            Some(h) if (h as usize) < self.triangles().len() => {
+                match self.prisms().closest_from(self.bvh(), p, h) {
+                    Ok(hit) => Some(hit),
+                    Err(seed) => self.bvh().closest_wide(p, Some(seed)),
+                }
+            }
+            _ => self.bvh().closest_wide(p, hint),
+        }
+        .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;
         let size = match self.sizes() {
@@ -124,6 +139,8 @@ impl Grid {
         if self.topology().body_count > 1 {
             self.contact_lists();
         }
+        // The hinted queries' prism table, likewise.
+        self.prisms();
         // Each chunk of consecutive points chains its hints.
         let run = |ps: &mut dyn Iterator<Item = &[f64; 3]>, os: &mut [f64]| -> Result<()> {
             let mut hint = u32::MAX;
