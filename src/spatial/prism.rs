@@ -509,9 +509,23 @@ mod tests {
             v.extend(v2);
             t.extend(t2.iter().map(|f| f.map(|k| k + o)));
             let s = Surface::new(v, t);
-            for z in s.mesh().build(false).slots.iter().map(|x| x.clear as f64) {
+            let table = s.mesh().build(false);
+            for z in table.slots.iter().map(|x| x.clear as f64) {
                 let want = gap.min(cap);
                 assert!(z <= want && z > want - 1e-6, "{z} against {want}");
+            }
+            // Two thirds of the gap above a lower triangle's centroid (deep
+            // inside its prism), the upper sheet is nearer: the walk from
+            // the lower triangle must not certify it.
+            for tri in 0..2 * n * n {
+                let c = s.bvh.prim_corners[s.bvh.triangle_prim[tri] as usize];
+                let mut p = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
+                p[2] = 2.0 * gap / 3.0;
+                let want = s.bvh.closest(p, None).unwrap();
+                assert!(want.triangle as usize >= 2 * n * n, "the upper sheet");
+                if let Ok(got) = table.closest_from(&s.bvh, p, tri as u32) {
+                    assert_eq!(got.triangle, want.triangle);
+                }
             }
         }
         // A fold sharper than a right angle: the two halves enter each
