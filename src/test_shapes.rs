@@ -8,6 +8,19 @@ pub(crate) fn rng(seed: &mut u64) -> f64 {
     (*seed >> 11) as f64 / (1u64 << 53) as f64
 }
 
+/// A point of triangle `c` for the `i`-th test point: its first corner when
+/// `i % 4 == 0`, the midpoint of its second edge when 1 (both ties between
+/// triangles), else a random point inside. Draws two numbers either way.
+pub(crate) fn triangle_point(c: &[[f64; 3]; 3], i: usize, seed: &mut u64) -> [f64; 3] {
+    let (a, b) = (rng(seed), rng(seed));
+    let (a, b) = match i % 4 {
+        0 => (1.0, 0.0),
+        1 => (0.5, 0.5),
+        _ => (a.min(1.0 - b), b.min(1.0 - a)),
+    };
+    [0, 1, 2].map(|k| c[0][k] * (1.0 - a - b) + c[1][k] * a + c[2][k] * b)
+}
+
 /// The unit square subdivided `n × n` (two triangles per cell, counter-
 /// clockwise seen from +z), lifted to `z(x, y)`: `(n+1)²` vertices row by
 /// row, `2n²` triangles.

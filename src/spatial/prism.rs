@@ -98,12 +98,6 @@ pub struct PrismMesh<'a> {
 }
 
 impl PrismMesh<'_> {
-    /// The corners of triangle `t`, as the BVH stores them.
-    #[inline(always)]
-    fn corners(&self, t: u32) -> &[[f64; 3]; 3] {
-        &self.bvh.prim_corners[self.bvh.triangle_prim[t as usize] as usize]
-    }
-
     /// The face across edge `k` of face `t`, if that edge has exactly two.
     #[inline(always)]
     fn across(&self, t: u32, k: usize) -> Option<u32> {
@@ -140,7 +134,7 @@ impl PrismMesh<'_> {
                     .map_or(NO_SLOT, |u| self.bvh.triangle_prim[u as usize])
             });
             let z = if in_range {
-                self.clearance(t)
+                self.clearance(slot)
             } else {
                 f64::NEG_INFINITY
             };
@@ -159,9 +153,10 @@ impl PrismMesh<'_> {
         Prisms { slots }
     }
 
-    /// The prism clearance of triangle `t`, less the rounding slack.
-    fn clearance(&self, t: u32) -> f64 {
-        let c = *self.corners(t);
+    /// The prism clearance of the triangle in BVH slot `slot`, less the
+    /// rounding slack.
+    fn clearance(&self, slot: usize) -> f64 {
+        let c = self.bvh.prim_corners[slot];
         let n2 = cross(sub(c[1], c[0]), sub(c[2], c[0]));
         let area2 = norm(n2);
         if area2.is_nan() || area2 <= 0.0 || area2.is_infinite() {
@@ -193,9 +188,9 @@ impl PrismMesh<'_> {
             g,
             reach * reach,
             |_| true,
-            |slot| {
-                if self.bvh.prim_triangle[slot] != t {
-                    let u = &self.bvh.prim_corners[slot];
+            |other| {
+                if other != slot {
+                    let u = &self.bvh.prim_corners[other];
                     if let Some(h) = height_inside(u, &sides, eps, c[0], n, z) {
                         z = z.min(h);
                     }
@@ -377,7 +372,7 @@ fn height_inside(
 mod tests {
     use super::*;
     use crate::mesh::Topology;
-    use crate::test_shapes::{rng, triangle_soup, unit_square};
+    use crate::test_shapes::{rng, triangle_point, triangle_soup, unit_square};
 
     /// A test surface with its topology and BVH.
     struct Surface {
@@ -430,12 +425,7 @@ mod tests {
         for i in 0..points {
             let tri = (rng(&mut seed) * t.len() as f64) as usize;
             let c = bvh.prim_corners[bvh.triangle_prim[tri] as usize];
-            let (a, b) = (rng(&mut seed), rng(&mut seed));
-            let (a, b) = match i % 4 {
-                0 => (1.0, 0.0),
-                1 => (0.5, 0.5),
-                _ => (a.min(1.0 - b), b.min(1.0 - a)),
-            };
+            let on = triangle_point(&c, i, &mut seed);
             let off = edge
                 * match i % 5 {
                     0 => 0.0,
@@ -444,8 +434,7 @@ mod tests {
                     _ => 0.1 * (rng(&mut seed) - 0.5),
                 };
             let dir = [rng(&mut seed) - 0.5, rng(&mut seed) - 0.5, 1.0];
-            let p = [0, 1, 2]
-                .map(|k| c[0][k] * (1.0 - a - b) + c[1][k] * a + c[2][k] * b + off * dir[k]);
+            let p = [0, 1, 2].map(|k| on[k] + off * dir[k]);
             let start = match i % 3 {
                 0 => tri,
                 1 => (tri + 1 + i % 5) % t.len(),

@@ -209,7 +209,7 @@ impl StarMesh<'_> {
 mod tests {
     use super::*;
     use crate::mesh::Topology;
-    use crate::test_shapes::{rng, unit_square};
+    use crate::test_shapes::{rng, triangle_point, unit_square};
 
     /// A test surface with its labels, topology and BVH.
     struct Surface {
@@ -273,20 +273,13 @@ mod tests {
             // edges (ties between triangles), some far off.
             let tri = (rng(&mut seed) * t.len() as f64) as usize;
             let c = bvh.prim_corners[bvh.triangle_prim[tri] as usize];
-            let (a, b) = (rng(&mut seed), rng(&mut seed));
-            let (a, b) = match i % 4 {
-                0 => (1.0, 0.0),
-                1 => (0.5, 0.5),
-                _ => (a.min(1.0 - b), b.min(1.0 - a)),
-            };
+            let on = triangle_point(&c, i, &mut seed);
             let off = match i % 5 {
                 0 => 0.0,
                 1 => 0.3,
                 _ => 0.01 * (rng(&mut seed) - 0.5),
             };
-            let p = [0, 1, 2].map(|k| {
-                c[0][k] * (1.0 - a - b) + c[1][k] * a + c[2][k] * b + if k == 2 { off } else { 0.0 }
-            });
+            let p = [on[0], on[1], on[2] + off];
             let label = labels[tri];
             // Start at the triangle itself or a few triangles away.
             let start = if i % 3 == 0 {
