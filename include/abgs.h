@@ -792,6 +792,12 @@ abgs_status abgs_hausdorff_directed(const abgs_grid *from,
 // Size at `point` (3 doubles): exact closest point on the grid, barycentric
 // interpolation there. Expected O(log F).
 //
+// Queries along a front need no hint: each thread remembers its last plain
+// answer (one, on the grid it was given on), and a point within a few
+// triangles of it is answered by the certified walk of `abgs_query_size_hinted` (the
+// first such query builds its table). The answer is the same bit for bit,
+// whatever the thread asked before.
+//
 // Ties between bodies: where bodies of an assembly touch, a point whose
 // closest point `q` on the grid has another body's face within the contact
 // gap `c` (diagonal / 2000) of `q` gets the smallest of those bodies' sizes,

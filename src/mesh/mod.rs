@@ -92,6 +92,9 @@ pub struct Grid {
     /// its edges and its prism clearance). Computed on first use
     /// ([`Grid::prisms`]).
     prisms: std::sync::OnceLock<crate::spatial::Prisms>,
+    /// Process-unique id (a clone keeps it): keys the thread's record of
+    /// its last plain query (module `query::recent`).
+    id: u64,
 }
 
 /// The arrays of a grid once checked, before its adjacency and hierarchy.
@@ -291,6 +294,7 @@ impl Grid {
             contact_lists: std::sync::OnceLock::new(),
             node_bodies: std::sync::OnceLock::new(),
             prisms: std::sync::OnceLock::new(),
+            id: crate::query::new_grid_id(),
         };
         if let Some(s) = sizes {
             grid.install_sizes(s);
@@ -514,6 +518,11 @@ impl Grid {
     pub(crate) fn prisms(&self) -> &crate::spatial::Prisms {
         self.prisms
             .get_or_init(|| self.prism_mesh().build(on_rayon_worker()))
+    }
+
+    /// The grid's process-unique id (a clone keeps its original's). O(1).
+    pub(crate) fn id(&self) -> u64 {
+        self.id
     }
 
     /// Bounding box of the vertices.

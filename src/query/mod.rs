@@ -25,7 +25,10 @@
 //!   that no other triangle can be as near (module
 //!   [`crate::spatial::PrismMesh`]'s doc) answer most such queries with one
 //!   exact point–triangle test; the others descend the BVH with their bound
-//!   seeded by that triangle.
+//!   seeded by that triangle. A plain query uses its thread's last plain
+//!   answer the same way when the point is near it (module `recent`), so
+//!   callers that cannot carry a hint (a Gmsh size callback) get the walk
+//!   too.
 //! - **batch**: many points in parallel (rayon), each answer identical to the
 //!   single query, whatever the thread count; a scattered batch is answered
 //!   along a Morton curve (module `order`), for warmer caches.
@@ -33,7 +36,10 @@
 //!   and bound (see [`volume`]).
 
 mod order;
+mod recent;
 pub mod volume;
+
+pub(crate) use recent::new_grid_id;
 
 use crate::error::{Error, Result};
 use crate::geometry::{is_coordinate3, MAX_COORDINATE};
@@ -74,21 +80,29 @@ impl Grid {
     /// parallel, 16 bytes per triangle), then a point near the surface a few
     /// triangles from its hint is answered in O(1) by a certified walk
     /// ([`crate::spatial::Prisms::closest_from`]), any other by the BVH.
-    /// Expected O(log F).
+    /// Without a hint, the calling thread's last answer without one on this
+    /// grid serves as the hint when `p` is within a few of its triangle's
+    /// edges (module `recent`: queries along a front are answered by the
+    /// walk without the caller carrying a hint). Expected O(log F).
     pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Result<QueryHit> {
         if !is_coordinate3(p) {
             return Err(non_finite_point(p));
         }
-        let hit = match hint {
+        let plain = hint.is_none();
+        let hint = hint.or_else(|| recent::hint_for(self.id(), &p));
+        let (hit, slot) = match hint {
             Some(h) if (h as usize) < self.triangles().len() => {
-                match self.prisms().closest_from(self.bvh(), p, h) {
+                match self.prisms().closest_from_in_slot(self.bvh(), p, h) {
                     Ok(hit) => Some(hit),
-                    Err(seed) => self.bvh().closest_wide(p, Some(seed)),
+                    Err(seed) => self.bvh().closest_wide_in_slot(p, Some(seed)),
                 }
             }
-            _ => self.bvh().closest_wide(p, hint),
+            _ => self.bvh().closest_wide_in_slot(p, hint),
         }
         .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
+        if plain {
+            recent::remember(self.id(), self.bvh(), slot);
+        }
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;
         let size = match self.sizes() {

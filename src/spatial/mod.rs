@@ -15,6 +15,6 @@ mod wide;
 pub use bvh::{Bvh, ClosestHit, Node, MAX_DEPTH, MIXED_LABEL};
 pub use forest::LabelForest;
 pub use layout::BvhLayout;
-pub use prism::{PrismMesh, PrismSlot, Prisms};
+pub use prism::{PrismMesh, PrismSlot, Prisms, FAR_HINT};
 pub use ray::ray_triangle;
 pub use star::StarMesh;

@@ -239,6 +239,16 @@ impl Prisms {
     /// certificate fails: then ask the BVH, with that triangle as its hint.
     /// O(1): at most `MAX_WALK` (8) steps.
     pub fn closest_from(&self, bvh: &Bvh, p: [f64; 3], start: u32) -> Result<ClosestHit, u32> {
+        self.closest_from_in_slot(bvh, p, start).map(|(h, _)| h)
+    }
+
+    /// [`Prisms::closest_from`] with the answer's primitive slot.
+    pub(crate) fn closest_from_in_slot(
+        &self,
+        bvh: &Bvh,
+        p: [f64; 3],
+        start: u32,
+    ) -> Result<(ClosestHit, u32), u32> {
         let Some(&first) = bvh.triangle_prim.get(start as usize) else {
             return Err(start);
         };
@@ -296,10 +306,13 @@ impl Prisms {
             });
             let t = bvh.prim_triangle[slot];
             return if deep && 2.0 * d + margin < info.clear as f64 {
-                Ok(ClosestHit {
-                    triangle: t,
-                    closest: cp,
-                })
+                Ok((
+                    ClosestHit {
+                        triangle: t,
+                        closest: cp,
+                    },
+                    slot as u32,
+                ))
             } else {
                 Err(t)
             };
