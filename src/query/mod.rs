@@ -90,18 +90,18 @@ impl Grid {
         }
         let plain = hint.is_none();
         let hint = hint.or_else(|| recent::hint_for(self.id(), &p));
-        let (hit, slot) = match hint {
+        let hit = match hint {
             Some(h) if (h as usize) < self.triangles().len() => {
-                match self.prisms().closest_from_in_slot(self.bvh(), p, h) {
+                match self.prisms().closest_from(self.bvh(), p, h) {
                     Ok(hit) => Some(hit),
-                    Err(seed) => self.bvh().closest_wide_in_slot(p, Some(seed)),
+                    Err(seed) => self.bvh().closest_wide(p, Some(seed)),
                 }
             }
-            _ => self.bvh().closest_wide_in_slot(p, hint),
+            _ => self.bvh().closest_wide(p, hint),
         }
         .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
         if plain {
-            recent::remember(self.id(), self.bvh(), slot);
+            recent::remember(self.id(), self.bvh(), hit.triangle);
         }
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;

@@ -6,8 +6,8 @@
 //! cannot: Gmsh's size callback receives a point and nothing else. So each
 //! thread keeps one record of its last plain answer (`Grid::closest` with
 //! no hint): the grid's id, the triangle, one of its corners and the radius
-//! within which a walk from it is tried ([`FAR_HINT`] of its longest
-//! edges, the walk's own bail-out). A plain query within that radius of
+//! within which a walk from it is tried (four of its longest edges, the
+//! walk's own bail-out: `walk_reach2`). A plain query within that radius of
 //! the corner is asked as a hinted one.
 //!
 //! **Same answers.** A hint changes the time, never the answer (the walk
@@ -19,11 +19,14 @@
 //! **Cost.** A scattered point set pays a thread-local read, one distance
 //! test against the record (no read of the grid) and a store of the new
 //! record from the answer's corners, which the search has just read.
+//! (Carrying the answer's BVH slot out of the search, to skip the one
+//! lookup of triangle → slot, was tried: no difference beyond noise.)
 //! Measured in one process against queries that neither read nor leave a
-//! record: 0.89–1.01 of their speed near the surface, 0.98–1.00 uniform in
+//! record: 0.95–1.00 of their speed near the surface, 0.98–1.03 uniform in
 //! the box (README, "Plain queries along a front"). A coherent set answers
-//! most points in O(1) with the walk: 1.3–2.1× faster on the harness's
-//! front walk. The first query that uses a record builds the grid's prism
+//! most points in O(1) with the walk: 1.09–2.07× faster on the harness's
+//! front walk (one alternating run of the 8 dense grids; this machine's
+//! reruns move more than that). The first query that uses a record builds the grid's prism
 //! table (O(F log F), parallel; once per grid).
 //!
 //! **Ties.** To the walk: the reach is [`crate::spatial::Prisms::closest_from`]'s
@@ -33,7 +36,7 @@
 //! a record of another grid is ignored, and a stale one could cost at most
 //! the walk's bail-out, never an answer.
 
-use crate::spatial::{Bvh, FAR_HINT};
+use crate::spatial::{walk_reach2, Bvh};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -70,24 +73,18 @@ pub(crate) fn hint_for(grid: u64, p: &[f64; 3]) -> Option<u32> {
     (r.grid == grid && d2 <= r.reach2).then_some(r.triangle)
 }
 
-/// Records the answer in primitive slot `slot` of `bvh` (on grid `grid`)
-/// as the thread's last plain answer. O(1): its corners are in cache, the
-/// search has just read them.
-pub(crate) fn remember(grid: u64, bvh: &Bvh, slot: u32) {
-    let (Some(&triangle), Some(c)) = (
-        bvh.prim_triangle.get(slot as usize),
-        bvh.prim_corners.get(slot as usize),
-    ) else {
+/// Records `triangle` (an answer on grid `grid`, searched in `bvh`) as the
+/// thread's last plain answer. O(1): its corners were just read by the search.
+pub(crate) fn remember(grid: u64, bvh: &Bvh, triangle: u32) {
+    let Some(&slot) = bvh.triangle_prim.get(triangle as usize) else {
         return;
     };
-    let longest2 = crate::geometry::dist2(c[0], c[1])
-        .max(crate::geometry::dist2(c[1], c[2]))
-        .max(crate::geometry::dist2(c[2], c[0]));
+    let c = &bvh.prim_corners[slot as usize];
     let record = Recent {
         grid,
         triangle,
         anchor: c[0],
-        reach2: FAR_HINT * FAR_HINT * longest2,
+        reach2: walk_reach2(c),
     };
     // During the thread's teardown there is no record to keep: nothing lost.
     let _ = RECENT.try_with(|r| r.set(Some(record)));

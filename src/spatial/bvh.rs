@@ -89,8 +89,6 @@ impl Corners for [[[f64; 3]; 3]] {
 /// Best candidate of a closest-point search.
 pub(super) struct Best {
     tri: u32,
-    /// `tri`'s primitive slot (`u32::MAX` with no candidate).
-    slot: u32,
     cp: ClosestPoint,
     /// Squared distance of the best candidate (or the initial bound).
     d2: f64,
@@ -104,7 +102,6 @@ impl Best {
     fn new(p: [f64; 3], bound2: f64, pad: f64) -> Best {
         Best {
             tri: u32::MAX,
-            slot: u32::MAX,
             cp: ClosestPoint {
                 point: p,
                 bary: [1.0, 0.0, 0.0],
@@ -116,35 +113,26 @@ impl Best {
         }
     }
 
-    /// Keeps `cp` (on triangle `tri`, in primitive slot `slot`) if it is
-    /// closer, or equally close with a lower triangle index.
+    /// Keeps `cp` (on triangle `tri`) if it is closer, or equally close with a
+    /// lower triangle index.
     #[inline(always)]
-    pub(super) fn offer(&mut self, tri: u32, slot: u32, cp: ClosestPoint) {
+    pub(super) fn offer(&mut self, tri: u32, cp: ClosestPoint) {
         if cp.dist2 < self.d2 || (cp.dist2 == self.d2 && tri < self.tri) {
             if cp.dist2 != self.d2 {
                 self.limit = padded(cp.dist2, self.pad);
             }
             self.d2 = cp.dist2;
             self.tri = tri;
-            self.slot = slot;
             self.cp = cp;
         }
     }
 
     /// The answer: the best candidate, if any.
     pub(super) fn hit(&self) -> Option<ClosestHit> {
-        self.hit_in_slot().map(|(h, _)| h)
-    }
-
-    /// The answer with its primitive slot.
-    pub(super) fn hit_in_slot(&self) -> Option<(ClosestHit, u32)> {
-        (self.tri != u32::MAX).then_some((
-            ClosestHit {
-                triangle: self.tri,
-                closest: self.cp,
-            },
-            self.slot,
-        ))
+        (self.tri != u32::MAX).then_some(ClosestHit {
+            triangle: self.tri,
+            closest: self.cp,
+        })
     }
 }
 
@@ -256,16 +244,6 @@ impl Bvh {
     /// built); the size queries of a [`crate::mesh::Grid`] use it. Expected
     /// O(log F).
     pub fn closest_wide(&self, p: [f64; 3], hint: Option<u32>) -> Option<ClosestHit> {
-        self.closest_wide_in_slot(p, hint).map(|(h, _)| h)
-    }
-
-    /// [`Bvh::closest_wide`] with the answer's primitive slot (the index of
-    /// its corners in [`Bvh::prim_corners`]).
-    pub(crate) fn closest_wide_in_slot(
-        &self,
-        p: [f64; 3],
-        hint: Option<u32>,
-    ) -> Option<(ClosestHit, u32)> {
         self.search_wide(p, hint, f64::INFINITY, |_| true, &self.prim_corners[..])
     }
 
@@ -373,9 +351,8 @@ impl Bvh {
         let mut best = Best::new(p, bound2, self.pad(&p));
         // In range first: `keep` may index by triangle.
         if let Some(h) = hint.filter(|&h| (h as usize) < self.triangle_prim.len() && keep(h)) {
-            let slot = self.triangle_prim[h as usize];
-            let c = corners.corners(slot as usize);
-            best.offer(h, slot, closest_point_triangle(p, c[0], c[1], c[2]));
+            let c = corners.corners(self.triangle_prim[h as usize] as usize);
+            best.offer(h, closest_point_triangle(p, c[0], c[1], c[2]));
         }
         best
     }
@@ -536,11 +513,7 @@ impl Bvh {
             let tri = self.prim_triangle[slot];
             if keep(tri) {
                 let c = corners.corners(slot);
-                best.offer(
-                    tri,
-                    slot as u32,
-                    closest_point_triangle(*p, c[0], c[1], c[2]),
-                );
+                best.offer(tri, closest_point_triangle(*p, c[0], c[1], c[2]));
             }
         }
     }

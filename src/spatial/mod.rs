@@ -15,6 +15,7 @@ mod wide;
 pub use bvh::{Bvh, ClosestHit, Node, MAX_DEPTH, MIXED_LABEL};
 pub use forest::LabelForest;
 pub use layout::BvhLayout;
-pub use prism::{PrismMesh, PrismSlot, Prisms, FAR_HINT};
+pub(crate) use prism::walk_reach2;
+pub use prism::{PrismMesh, PrismSlot, Prisms};
 pub use ray::ray_triangle;
 pub use star::StarMesh;

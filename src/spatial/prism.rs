@@ -123,10 +123,11 @@ impl PrismMesh<'_> {
         // A grid with a longest edge outside `EDGE_RANGE` gets no
         // certificate at all.
         let (lo, hi) = (EDGE_RANGE.0 * EDGE_RANGE.0, EDGE_RANGE.1 * EDGE_RANGE.1);
-        let in_range = self.bvh.prim_corners.iter().all(|&[a, b, c]| {
-            let l2 = dist2(a, b).max(dist2(b, c)).max(dist2(c, a));
-            (lo..=hi).contains(&l2)
-        });
+        let in_range = self
+            .bvh
+            .prim_corners
+            .iter()
+            .all(|&[a, b, c]| (lo..=hi).contains(&longest_edge2(&[a, b, c])));
         let one = |slot: usize| {
             let t = self.bvh.prim_triangle[slot];
             let across = [0, 1, 2].map(|k| {
@@ -176,10 +177,7 @@ impl PrismMesh<'_> {
             };
             (a, m)
         });
-        let longest2 = dist2(c[0], c[1])
-            .max(dist2(c[1], c[2]))
-            .max(dist2(c[2], c[0]));
-        let cap = CLEARANCE_CAP * longest2.sqrt();
+        let cap = CLEARANCE_CAP * longest_edge2(&c).sqrt();
         let g = [0, 1, 2].map(|k| (c[0][k] + c[1][k] + c[2][k]) / 3.0);
         let r = c.iter().map(|&x| dist2(g, x)).fold(0.0, f64::max).sqrt();
         let reach = (r + cap) * (1.0 + 1e-9);
@@ -239,16 +237,6 @@ impl Prisms {
     /// certificate fails: then ask the BVH, with that triangle as its hint.
     /// O(1): at most `MAX_WALK` (8) steps.
     pub fn closest_from(&self, bvh: &Bvh, p: [f64; 3], start: u32) -> Result<ClosestHit, u32> {
-        self.closest_from_in_slot(bvh, p, start).map(|(h, _)| h)
-    }
-
-    /// [`Prisms::closest_from`] with the answer's primitive slot.
-    pub(crate) fn closest_from_in_slot(
-        &self,
-        bvh: &Bvh,
-        p: [f64; 3],
-        start: u32,
-    ) -> Result<(ClosestHit, u32), u32> {
         let Some(&first) = bvh.triangle_prim.get(start as usize) else {
             return Err(start);
         };
@@ -262,10 +250,7 @@ impl Prisms {
         // needs it within two longest edges of its own triangle, is far
         // off the surface or far from the hint. The BVH answers at once.
         let c = &bvh.prim_corners[slot];
-        let longest2 = dist2(c[0], c[1])
-            .max(dist2(c[1], c[2]))
-            .max(dist2(c[2], c[0]));
-        if dist2(p, c[0]) > FAR_HINT * FAR_HINT * longest2 {
+        if dist2(p, c[0]) > walk_reach2(c) {
             return Err(start);
         }
         let margin = 8.0 * bvh.rounding_scale(&p);
@@ -306,19 +291,30 @@ impl Prisms {
             });
             let t = bvh.prim_triangle[slot];
             return if deep && 2.0 * d + margin < info.clear as f64 {
-                Ok((
-                    ClosestHit {
-                        triangle: t,
-                        closest: cp,
-                    },
-                    slot as u32,
-                ))
+                Ok(ClosestHit {
+                    triangle: t,
+                    closest: cp,
+                })
             } else {
                 Err(t)
             };
         }
         Err(bvh.prim_triangle[slot])
     }
+}
+
+/// Squared length of the longest edge of the triangle with corners `c`.
+fn longest_edge2(c: &[[f64; 3]; 3]) -> f64 {
+    dist2(c[0], c[1])
+        .max(dist2(c[1], c[2]))
+        .max(dist2(c[2], c[0]))
+}
+
+/// Squared radius around the first corner of the triangle with corners `c`
+/// (in the BVH's order) beyond which [`Prisms::closest_from`] does not walk
+/// from it: [`FAR_HINT`] of its longest edges. O(1).
+pub(crate) fn walk_reach2(c: &[[f64; 3]; 3]) -> f64 {
+    FAR_HINT * FAR_HINT * longest_edge2(c)
 }
 
 /// The least `|height|` over `t`'s plane (through `o`, unit normal `n`) of

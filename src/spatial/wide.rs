@@ -247,7 +247,7 @@ impl Bvh {
         bound2: f64,
         keep: impl Fn(u32) -> bool,
         corners: &(impl Corners + ?Sized),
-    ) -> Option<(ClosestHit, u32)> {
+    ) -> Option<ClosestHit> {
         let wide = self.wide();
         if wide.nodes.is_empty() {
             return None;
@@ -314,7 +314,7 @@ impl Bvh {
                     }
                 }
                 if next.is_none() {
-                    return best.hit_in_slot();
+                    return best.hit();
                 }
             }
         }
@@ -395,14 +395,12 @@ mod tests {
             let binary = bvh.closest(p, hint);
             assert_eq!(bvh.closest_wide(p, hint), binary, "at {p:?}");
             assert_eq!(
-                bvh.search_wide(p, hint, f64::INFINITY, keep, corners)
-                    .map(|(h, _)| h),
+                bvh.search_wide(p, hint, f64::INFINITY, keep, corners),
                 bvh.closest_filtered(p, hint, keep)
             );
             let r = binary.unwrap().closest.dist2.sqrt() * rng.gen_range(0.5..1.5);
             assert_eq!(
-                bvh.search_wide(p, None, r * r, keep, corners)
-                    .map(|(h, _)| h),
+                bvh.search_wide(p, None, r * r, keep, corners),
                 bvh.closest_filtered_within(p, r, keep)
             );
         }
