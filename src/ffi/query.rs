@@ -32,7 +32,9 @@ versioned!(abgs_hit, 72);
 /// answer (one, on the grid it was given on), and a point within a few
 /// triangles of it is answered by the certified walk of `abgs_query_size_hinted` (the
 /// first such query builds its table). The answer is the same bit for bit,
-/// whatever the thread asked before.
+/// whatever the thread asked before. Points in random order stop using it:
+/// after three misses in a row the thread sets its record aside for 1, 2,
+/// 4, … up to 64 queries.
 ///
 /// Ties between bodies: where bodies of an assembly touch, a point whose
 /// closest point `q` on the grid has another body's face within the contact
@@ -71,7 +73,10 @@ pub unsafe extern "C" fn abgs_query_size(
 /// changes: a point near the surface a few triangles from its hint (as an
 /// advancing front queries) is answered by a certified walk without a tree
 /// descent. The grid's first hinted query builds the table that walk reads
-/// (O(F log F), parallel, 16 bytes per triangle).
+/// (O(F log F), parallel, 16 bytes per triangle). Hints chained through
+/// points in random order are set aside as the plain record is (three
+/// misses in a row; counted apart): their queries descend the tree, seeded
+/// by the hint.
 ///
 /// # Safety
 /// Each pointer is NULL (reported as ABGS_ERR_NULL) or valid for the stated

@@ -83,25 +83,45 @@ impl Grid {
     /// Without a hint, the calling thread's last answer without one on this
     /// grid serves as the hint when `p` is within a few of its triangle's
     /// edges (module `recent`: queries along a front are answered by the
-    /// walk without the caller carrying a hint). Expected O(log F).
+    /// walk without the caller carrying a hint). After three walks in a row
+    /// that missed (or points out of the record's reach), the walk is set
+    /// aside for 1, 2, 4, … up to 64 queries, counted per thread and grid,
+    /// apart for the caller's hints and the record: points in random order
+    /// pay for no walk that cannot help. Expected O(log F).
     pub fn closest(&self, p: [f64; 3], hint: Option<u32>) -> Result<QueryHit> {
         if !is_coordinate3(p) {
             return Err(non_finite_point(p));
         }
         let plain = hint.is_none();
         let hint = hint.or_else(|| recent::hint_for(self.id(), &p));
+        // Whether the walk certified its answer (`None`: not walked).
+        let mut walked = None;
         let hit = match hint {
-            Some(h) if (h as usize) < self.triangles().len() => {
+            Some(h)
+                if (h as usize) < self.triangles().len()
+                    && (plain || recent::may_walk_from_hint(self.id())) =>
+            {
                 match self.prisms().closest_from(self.bvh(), p, h) {
-                    Ok(hit) => Some(hit),
-                    Err(seed) => self.bvh().closest_wide(p, Some(seed)),
+                    Ok(hit) => {
+                        walked = Some(true);
+                        Some(hit)
+                    }
+                    Err(seed) => {
+                        let hit = self.bvh().closest_wide(p, Some(seed));
+                        // A walk that ended on the answer seeded the
+                        // descent with its exact bound: not a failure.
+                        walked = Some(hit.is_some_and(|h| h.triangle == seed));
+                        hit
+                    }
                 }
             }
             _ => self.bvh().closest_wide(p, hint),
         }
         .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
         if plain {
-            recent::remember(self.id(), self.bvh(), hit.triangle);
+            recent::remember(self.id(), self.bvh(), hit.triangle, walked);
+        } else if let Some(certified) = walked {
+            recent::walked_from_hint(self.id(), certified);
         }
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;
