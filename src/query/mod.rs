@@ -94,7 +94,8 @@ impl Grid {
         }
         let plain = hint.is_none();
         let hint = hint.or_else(|| recent::hint_for(self.id(), &p));
-        // Whether the walk certified its answer (`None`: not walked).
+        // Whether the walk helped: it certified its answer or ended on it
+        // (`None`: not walked). A walk that did not counts as a miss.
         let mut walked = None;
         let hit = match hint {
             Some(h)
@@ -109,7 +110,7 @@ impl Grid {
                     Err(seed) => {
                         let hit = self.bvh().closest_wide(p, Some(seed));
                         // A walk that ended on the answer seeded the
-                        // descent with its exact bound: not a failure.
+                        // descent with its exact bound: not a miss.
                         walked = Some(hit.is_some_and(|h| h.triangle == seed));
                         hit
                     }
