@@ -121,8 +121,8 @@ impl Grid {
         .ok_or_else(|| Error::Empty("grid has no triangles".into()))?;
         if plain {
             recent::remember(self.id(), self.bvh(), hit.triangle, walked);
-        } else if let Some(certified) = walked {
-            recent::walked_from_hint(self.id(), certified);
+        } else if let Some(helped) = walked {
+            recent::walked_from_hint(self.id(), helped);
         }
         let t = self.triangles()[hit.triangle as usize];
         let b = hit.closest.bary;

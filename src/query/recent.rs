@@ -40,8 +40,10 @@
 //! search, to skip the one lookup of triangle → slot, was tried: no
 //! difference beyond noise.) Measured in one process against queries that
 //! neither read nor leave a record: 0.93–1.02 of their speed near the
-//! surface and uniform in the box, dense and simplified grids (README,
-//! "Plain queries along a front"). A coherent set answers
+//! surface and uniform in the box, dense and simplified grids, in one run
+//! (0.89–1.06 in reruns on dense grids, where the record-free queries
+//! themselves moved by up to 25 %; README, "Back-off for points in random
+//! order"). A coherent set answers
 //! most points in O(1) with the walk: 1.09–2.07× faster on the harness's
 //! front walk (one alternating run of the 8 dense grids; this machine's
 //! reruns move more than that). The first query that uses a record builds the grid's prism
@@ -83,10 +85,19 @@ impl Misses {
         }
     }
 
-    /// Counts a walk that certified its answer (`true`: the count clears)
-    /// or missed (one more, and the back-off that follows).
-    fn count(&mut self, certified: bool) {
-        if certified {
+    /// Whether the next query may walk: not while set aside, and then the
+    /// query uses up one skip.
+    fn take(&mut self) -> bool {
+        let walk = self.skip == 0;
+        self.skip = self.skip.saturating_sub(1);
+        walk
+    }
+
+    /// Counts a walk that helped (certified its answer or ended on it:
+    /// `true`, the count clears) or missed (one more, and the back-off
+    /// that follows).
+    fn count(&mut self, helped: bool) {
+        if helped {
             (self.count, self.skip) = (0, 0);
         } else {
             self.count = self.count.saturating_add(1);
@@ -150,8 +161,7 @@ pub(crate) fn hint_for(grid: u64, p: &[f64; 3]) -> Option<u32> {
             if r.misses.grid != grid {
                 return None;
             }
-            if r.misses.skip > 0 {
-                r.misses.skip -= 1;
+            if !r.misses.take() {
                 cell.set(Some(r));
                 return None;
             }
@@ -171,8 +181,8 @@ pub(crate) fn hint_for(grid: u64, p: &[f64; 3]) -> Option<u32> {
 
 /// Records `triangle` (an answer on grid `grid`, searched in `bvh`) as the
 /// thread's last plain answer; `walked` says whether a walk from the last
-/// record certified it (`Some(true)`), missed (`Some(false)`) or was not
-/// tried. While the record is set aside it is left as it is, and refreshed
+/// record helped (`Some(true)`: it certified the answer or ended on it),
+/// missed (`Some(false)`) or was not tried. While the record is set aside it is left as it is, and refreshed
 /// by the last query that skips it. O(1): the answer's corners were just
 /// read by the search.
 pub(crate) fn remember(grid: u64, bvh: &Bvh, triangle: u32, walked: Option<bool>) {
@@ -187,8 +197,8 @@ pub(crate) fn remember(grid: u64, bvh: &Bvh, triangle: u32, walked: Option<bool>
             Some(r) => r.misses.on(grid),
             None => Misses::default().on(grid),
         };
-        if let Some(certified) = walked {
-            misses.count(certified);
+        if let Some(helped) = walked {
+            misses.count(helped);
         }
         cell.set(Some(Recent {
             triangle,
@@ -206,20 +216,19 @@ pub(crate) fn may_walk_from_hint(grid: u64) -> bool {
     HINTED
         .try_with(|cell| {
             let mut m = cell.get().on(grid);
-            let walk = m.skip == 0;
-            m.skip = m.skip.saturating_sub(1);
+            let walk = m.take();
             cell.set(m);
             walk
         })
         .unwrap_or(true)
 }
 
-/// Counts a walk from the caller's own hint on grid `grid`: certified
-/// (`true`) or missed. O(1).
-pub(crate) fn walked_from_hint(grid: u64, certified: bool) {
+/// Counts a walk from the caller's own hint on grid `grid`: helped
+/// (`true`: it certified the answer or ended on it) or missed. O(1).
+pub(crate) fn walked_from_hint(grid: u64, helped: bool) {
     let _ = HINTED.try_with(|cell| {
         let mut m = cell.get().on(grid);
-        m.count(certified);
+        m.count(helped);
         cell.set(m);
     });
 }
