@@ -43,6 +43,41 @@ pub(crate) fn unit_square(n: usize, z: impl Fn(f64, f64) -> f64) -> (Vec<[f64; 3
     (v, t)
 }
 
+/// The unit cube as 6 outward faces, each an `n`×`n` grid of squares split
+/// into two triangles (6 smooth patches, 12 crease lines).
+pub(crate) fn box_grid(n: usize) -> crate::mesh::Grid {
+    let mut v: Vec<[f64; 3]> = Vec::new();
+    let mut t: Vec<[u32; 3]> = Vec::new();
+    let mut face = |o: [f64; 3], a: [f64; 3], b: [f64; 3]| {
+        let base = v.len() as u32;
+        for j in 0..=n {
+            for i in 0..=n {
+                let (s, r) = (i as f64 / n as f64, j as f64 / n as f64);
+                v.push([0, 1, 2].map(|k| o[k] + s * a[k] + r * b[k]));
+            }
+        }
+        let id = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
+        for j in 0..n {
+            for i in 0..n {
+                t.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                t.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+    };
+    let (x, y, z) = ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
+    face([0.0; 3], y, x);
+    face([0.0, 0.0, 1.0], x, y);
+    face([0.0; 3], x, z);
+    face([0.0, 1.0, 0.0], z, x);
+    face([0.0; 3], z, y);
+    face([1.0, 0.0, 0.0], y, z);
+    let opts = crate::mesh::BuildOptions {
+        weld_relative_tolerance: Some(1e-9),
+        orient: false,
+    };
+    crate::mesh::Grid::from_arrays(v, t, None, &opts).expect("valid box")
+}
+
 /// Four open sheets: three meet along the line `y = z = 0`, `0 ≤ x ≤ 1` (a
 /// non-manifold edge line: the first is bent, `z = 0.1·x·y`, the second
 /// stands on the line, the third continues the first into `y < 0`), the

@@ -29,6 +29,11 @@ pub struct GridArgs {
     /// Elements per full circle in the curvature cap.
     #[arg(long, default_value_t = 24.0)]
     pub n_circle: f64,
+    /// Unstable, opt-in: a body expected to make more than twice this many
+    /// triangles is cut along its creases into pieces remeshed side by side
+    /// (e.g. 50000; default "inf": never; see README "Large bodies in pieces").
+    #[arg(long, default_value_t = f64::INFINITY)]
+    pub piece_faces: f64,
     /// Size-driven mode: target lengths from this grid's sizes (point array `size`,
     /// e.g. the VTK written by `abgs size`).
     #[arg(long, value_name = "GRID", conflicts_with_all = ["edge_length", "relative"])]
@@ -57,6 +62,7 @@ impl GridArgs {
             iterations: self.iterations,
             curvature_limit: !self.no_curvature_limit,
             n_circle: self.n_circle,
+            piece_faces: self.piece_faces,
             ..d
         })
     }
@@ -151,6 +157,12 @@ fn print_report(output: &Path, input: &Grid, r: &Remeshed, size_from: Option<&Pa
             last.collapses,
             last.flips,
             p.final_flips
+        );
+    }
+    if p.pieces > 0 {
+        eprintln!(
+            "large bodies cut into {} pieces along {} crease edges, remeshed side by side",
+            p.pieces, p.build.cut_edges
         );
     }
     eprintln!("time {:.3} s", p.seconds);

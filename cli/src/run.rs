@@ -28,6 +28,12 @@ pub struct RunArgs {
     /// Elements per full circle (curvature sizes and the dense grid's curvature cap).
     #[arg(long, default_value_t = 24.0)]
     pub n_circle: f64,
+    /// Dense grid, unstable, opt-in: a body expected to make more than twice
+    /// this many triangles is cut along its creases into pieces remeshed side
+    /// by side (e.g. 50000; default "inf": never; see README "Large bodies in
+    /// pieces").
+    #[arg(long, default_value_t = f64::INFINITY)]
+    pub piece_faces: f64,
     /// Elements across a gap or wall.
     #[arg(long, default_value_t = 3.0)]
     pub n_gap: f64,
@@ -85,9 +91,11 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         target: TargetLength::Relative(a.relative),
         feature_angle_deg: a.feature_angle,
         n_circle: a.n_circle,
+        piece_faces: a.piece_faces,
         ..Default::default()
     };
     let remeshed = stage("dense grid", &mut stages, || remesh(&surface, &rp))?;
+    let remeshed_pieces = remeshed.report.pieces;
     let mut dense = remeshed.grid;
     let sp = SizeParams {
         n_circle: a.n_circle,
@@ -162,7 +170,8 @@ pub fn run(input: &Path, a: &RunArgs) -> Result<()> {
         "parameters": {
             "dense_grid": {"relative_length": a.relative, "feature_angle_deg": a.feature_angle,
                            "n_circle": a.n_circle, "curvature_limit": rp.curvature_limit,
-                           "iterations": rp.iterations},
+                           "iterations": rp.iterations, "piece_faces": rp.piece_faces,
+                           "pieces": remeshed_pieces},
             "sizes": {"n_circle": a.n_circle, "n_gap": a.n_gap, "beta": a.beta,
                       "hmin": fields.report.hmin, "hmax": fields.report.hmax,
                       "feature_angle_deg": a.feature_angle},

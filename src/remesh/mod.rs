@@ -27,18 +27,21 @@
 //! apart) are remeshed side by side, largest expected output first
 //! (`expected_faces`), and within a part
 //! relaxation and projection run in parallel; a part's topological passes
-//! are sequential, so a single large body gains only from the latter. The
+//! are sequential, so a single large body gains only from the latter,
+//! unless [`RemeshParams::piece_faces`] (unstable, opt-in) cuts it along
+//! its creases into pieces that are parts of their own ([`pieces`]). The
 //! output does not depend on the thread count.
 
 mod field;
 mod locked;
 pub(crate) mod ops;
+pub mod pieces;
 pub mod quality;
 pub mod reference;
 mod smooth;
 
 use crate::error::{Error, Result};
-use crate::mesh::halfedge::{BuildReport, HalfedgeMesh, E_LOCKED, V_CORNER, V_FEATURE};
+use crate::mesh::halfedge::{BuildReport, HalfedgeMesh, E_CUT, E_LOCKED, V_CORNER, V_FEATURE};
 use crate::mesh::{BuildOptions, Features, Grid};
 use ops::Limits;
 use rayon::prelude::*;
@@ -91,6 +94,13 @@ pub struct RemeshParams {
     /// A collapse may remove a vertex only if it lies within this fraction of
     /// the local target length of the surface (and feature line) left (0.05).
     pub fidelity: f64,
+    /// **Unstable, opt-in.** A body expected to make more than twice this
+    /// many triangles is cut along its creases into pieces of about this
+    /// many, remeshed side by side ([`pieces`]; default infinite: never
+    /// cut). The pieces do not depend on the thread count, but the grid
+    /// differs from the whole body's; a cut that leaves zero-area triangles
+    /// or changes the bodies is undone (remeshed whole, at twice the cost).
+    pub piece_faces: f64,
 }
 
 impl Default for RemeshParams {
@@ -109,6 +119,7 @@ impl Default for RemeshParams {
             max_normal_turn_deg: 60.0,
             sliver_angle_deg: 10.0,
             fidelity: 0.05,
+            piece_faces: f64::INFINITY,
         }
     }
 }
@@ -151,6 +162,9 @@ pub struct RemeshReport {
     pub feature_edges_in: usize,
     /// Feature lines (chains of feature edges between corners, or loops).
     pub feature_lines: usize,
+    /// Pieces the large bodies were cut into, remeshed side by side
+    /// ([`pieces`]; 0 when no body was cut).
+    pub pieces: usize,
     /// Smooth patches narrower than half their target length, remeshed from
     /// their rims only (no vertices inside).
     pub thin_patches: usize,
@@ -231,7 +245,14 @@ fn check(params: &RemeshParams) -> Result<()> {
         "max_normal_turn_deg",
     )?;
     within(params.sliver_angle_deg, 0.0, 60.0, "sliver_angle_deg")?;
-    within(params.fidelity, 0.0, 1e9, "fidelity")
+    within(params.fidelity, 0.0, 1e9, "fidelity")?;
+    if params.piece_faces.is_nan() || params.piece_faces <= 0.0 {
+        return Err(Error::InvalidArgument(format!(
+            "piece_faces = {} must be > 0 (infinite: never cut)",
+            params.piece_faces
+        )));
+    }
+    Ok(())
 }
 
 fn run(
@@ -245,7 +266,6 @@ fn run(
     check(params)?;
     let start = Instant::now();
     let features = Features::detect(input, params.feature_angle_deg);
-    let (mut mesh, build) = HalfedgeMesh::from_grid(input, Some(&features));
     let base: Vec<f64> = match (l0, sizing) {
         (Some(l), _) => vec![l; input.vertices().len()],
         (None, Some(g)) => input
@@ -278,18 +298,28 @@ fn run(
         .collect();
     let cap = field::SourceField::new(&cap, params.gradation);
     let edge_is_feature: Vec<bool> = features.edge_flags.iter().map(|&f| f != 0).collect();
+    let no_lines = reference::FeatureLines::default();
+    let sizes = Reference {
+        grid: input,
+        face_patch: &features.face_patch,
+        edge_is_feature: &edge_is_feature,
+        thin_patch: &[],
+        lines: &no_lines,
+        base: l0,
+        cap: &cap,
+        sizing,
+    };
+    // Large bodies come apart in pieces along their creases (see `pieces`).
+    let vertex_target: Vec<f64> = input
+        .vertices()
+        .par_iter()
+        .map(|&p| sizes.target(p))
+        .collect();
+    let thin = thin_patches(input, &features, &widths, &vertex_target);
+    let cut = pieces::pieces(input, &features, &thin, &vertex_target, params.piece_faces);
+    let (mut mesh, build) =
+        HalfedgeMesh::from_grid_cut(input, Some(&features), cut.as_ref().map(|c| &c.piece[..]));
     {
-        let no_lines = reference::FeatureLines::default();
-        let sizes = Reference {
-            grid: input,
-            face_patch: &features.face_patch,
-            edge_is_feature: &edge_is_feature,
-            thin_patch: &[],
-            lines: &no_lines,
-            base: l0,
-            cap: &cap,
-            sizing,
-        };
         locked::presplit(
             &mut mesh,
             |p| sizes.target(p),
@@ -307,7 +337,6 @@ fn run(
         cap: &cap,
         sizing,
     };
-    let thin = thin_patches(input, &features, &widths, &reference);
     reference.thin_patch = &thin;
     let thin_patches = thin.iter().filter(|&&x| x).count();
     let lim = Limits {
@@ -329,6 +358,7 @@ fn run(
         target_length: l0.unwrap_or(f64::NAN),
         feature_edges_in: features.feature_edge_count(),
         feature_lines: lines.line_count as usize,
+        pieces: cut.as_ref().map_or(0, |c| c.pieces),
         thin_patches,
         corners: mesh
             .vertices()
@@ -401,6 +431,28 @@ fn run(
             orient: false,
         },
     )?;
+    // The safety net of the cut (see `pieces`): a seam that left zero-area
+    // triangles or changed the bodies is undone by remeshing whole.
+    let bodies = |g: &Grid| g.topology().body_count;
+    if cut.is_some() && (grid.report().dropped_zero_area > 0 || bodies(&grid) != bodies(input)) {
+        let why = format!(
+            "cutting large bodies into {} pieces left {} zero-area triangles and {} bodies \
+             (not {}): remeshed whole instead",
+            report.pieces,
+            grid.report().dropped_zero_area,
+            bodies(&grid),
+            bodies(input)
+        );
+        drop(grid);
+        let whole_params = RemeshParams {
+            piece_faces: f64::INFINITY,
+            ..params.clone()
+        };
+        let mut again = run(input, sizing, l0, &whole_params, whole)?;
+        again.report.issues.push(why);
+        again.report.seconds = start.elapsed().as_secs_f64();
+        return Ok(again);
+    }
     if grid.report().dropped_zero_area > 0 {
         report.issues.push(format!(
             "{} zero-area triangles were dropped from the output",
@@ -450,7 +502,6 @@ fn coarse_levels(mesh: &mut HalfedgeMesh, reference: &Reference, lim: &Limits) {
 /// trimesh_fm1_satellite a part of 6,502 input faces becomes 256,534, one of
 /// 22,876 becomes 175,762). O(F).
 fn expected_faces(mesh: &HalfedgeMesh) -> f64 {
-    let per_area = 4.0 / 3f64.sqrt();
     mesh.faces()
         .map(|f| {
             let l = mesh
@@ -459,13 +510,7 @@ fn expected_faces(mesh: &HalfedgeMesh) -> f64 {
                 .iter()
                 .sum::<f64>()
                 / 3.0;
-            let area = 0.5 * crate::geometry::norm(mesh.face_normal2(f));
-            let faces = per_area * area / (l * l);
-            if faces.is_finite() {
-                faces
-            } else {
-                0.0
-            }
+            pieces::expected(0.5 * crate::geometry::norm(mesh.face_normal2(f)), l)
         })
         .sum()
 }
@@ -546,18 +591,8 @@ fn iterate(
 /// Patches narrower than half their target length (twice the area over the
 /// perimeter): such a strip cannot hold vertices inside (they would sit on
 /// its rims and make flat faces), so it is remeshed from its rims only.
-fn thin_patches(
-    input: &Grid,
-    features: &Features,
-    width: &[f64],
-    reference: &Reference,
-) -> Vec<bool> {
+fn thin_patches(input: &Grid, features: &Features, width: &[f64], vt: &[f64]) -> Vec<bool> {
     let mut target = vec![f64::INFINITY; width.len()];
-    let vt: Vec<f64> = input
-        .vertices()
-        .iter()
-        .map(|&p| reference.target(p))
-        .collect();
     for (f, tri) in input.triangles().iter().enumerate() {
         let p = features.face_patch[f] as usize;
         for &i in tri {
@@ -582,9 +617,10 @@ fn issues(mesh: &HalfedgeMesh, report: &RemeshReport) -> Vec<String> {
             b.split_vertices, b.extra_copies
         ));
     }
+    // Cuts between pieces are locked too, but merge with no trace.
     let locked = mesh
         .edges()
-        .filter(|&e| mesh.edge_flags[e as usize] & E_LOCKED != 0)
+        .filter(|&e| mesh.edge_flags[e as usize] & (E_LOCKED | E_CUT) == E_LOCKED)
         .count();
     if locked > 0 {
         out.push(format!(

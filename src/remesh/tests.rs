@@ -134,3 +134,63 @@ fn expected_faces_predicts_the_output() {
     m.vertex_size.iter_mut().for_each(|h| *h = f64::INFINITY);
     assert_eq!(super::expected_faces(&m), 0.0);
 }
+
+/// A body expected to make many more triangles than `piece_faces` is cut
+/// along its creases into pieces remeshed side by side: the output is one
+/// closed body with no seam (every cut vertex merged), the same bits for
+/// any thread count, and passes the dense grid's acceptance; with no cut it
+/// reports no pieces.
+#[test]
+fn a_large_body_is_cut_into_pieces_with_no_seam() {
+    let g = crate::test_shapes::box_grid(4);
+    let l0 = 0.05;
+    let params = RemeshParams {
+        iterations: 6,
+        piece_faces: 1_000.0,
+        ..RemeshParams::default()
+    };
+    let mut outs = Vec::new();
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        outs.push(pool.install(|| run(&g, None, Some(l0), &params, false).unwrap()));
+    }
+    let out = &outs[0];
+    let r = &out.report;
+    assert!(r.pieces >= 2, "{r:?}");
+    assert!(r.build.cut_edges > 0 && r.build.cut_vertices > 0, "{r:?}");
+    assert_eq!(r.build.split_vertices + r.build.locked_edges, 0, "{r:?}");
+    assert!(r.issues.is_empty(), "{:?}", r.issues);
+    let (v, t) = (out.grid.vertices(), out.grid.triangles());
+    let topo = out.grid.topology();
+    assert_eq!(topo.body_count, 1);
+    assert!((0..topo.edges.len()).all(|e| topo.faces_of_edge(e).len() == 2));
+    // A closed sphere-like surface: V − E + F = 2.
+    assert_eq!(v.len() + t.len(), topo.edges.len() + 2);
+    let a = super::quality::evaluate(&g, &out.grid, Some(&out.feature_edges), 30.0, 20_000);
+    assert!(a.failures().is_empty(), "{:?}\n{a:?}", a.failures());
+    let b = &outs[1].grid;
+    assert_eq!(
+        canonical_triangles(v, t),
+        canonical_triangles(b.vertices(), b.triangles())
+    );
+    let whole = RemeshParams {
+        piece_faces: f64::INFINITY,
+        ..params
+    };
+    let w = run(&g, None, Some(l0), &whole, false).unwrap();
+    assert_eq!(w.report.pieces + w.report.build.cut_edges, 0);
+    assert!(run(
+        &g,
+        None,
+        Some(l0),
+        &RemeshParams {
+            piece_faces: 0.0,
+            ..whole.clone()
+        },
+        false
+    )
+    .is_err());
+}

@@ -5,7 +5,7 @@
 //! that still cannot be linked (two faces claiming one directed edge) is
 //! detached with its own locked corners.
 
-use super::{HalfedgeMesh, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED};
+use super::{HalfedgeMesh, E_CUT, E_FEATURE, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED};
 use crate::mesh::features::NON_MANIFOLD;
 use crate::mesh::{Features, Grid};
 use std::collections::HashMap;
@@ -29,6 +29,12 @@ pub struct BuildReport {
     pub locked_edges: usize,
     /// Input vertices referenced by no face (dropped).
     pub unreferenced_vertices: usize,
+    /// Input vertices on a cut between pieces of one body
+    /// ([`HalfedgeMesh::from_grid_cut`]); their copies are locked, like
+    /// those of split vertices, but not counted there.
+    pub cut_vertices: usize,
+    /// Input edges on such a cut ([`E_CUT`]; not counted in `locked_edges`).
+    pub cut_edges: usize,
 }
 
 /// Tiny union-find over local indices.
@@ -54,6 +60,22 @@ impl HalfedgeMesh {
     /// patches come from `features` (0 without). Sizes are 0, hints the index of
     /// an input face at the vertex, origins the input vertex. O(F) expected.
     pub fn from_grid(grid: &Grid, features: Option<&Features>) -> (HalfedgeMesh, BuildReport) {
+        HalfedgeMesh::from_grid_cut(grid, features, None)
+    }
+
+    /// [`HalfedgeMesh::from_grid`] with the faces in `pieces` (one label per
+    /// input face): two faces with different labels are never linked, so the
+    /// edges between pieces become a boundary of each, flagged
+    /// [`E_FEATURE`] | [`E_LOCKED`] | [`E_CUT`], and their vertices locked
+    /// copies ([`V_LOCKED`] | [`V_CORNER`], the input vertex as origin) that
+    /// [`HalfedgeMesh::to_arrays`] merges again: the pieces come apart as
+    /// parts ([`HalfedgeMesh::into_parts`]) that can be worked on side by
+    /// side and put back with no seam. O(F) expected.
+    pub fn from_grid_cut(
+        grid: &Grid,
+        features: Option<&Features>,
+        pieces: Option<&[u32]>,
+    ) -> (HalfedgeMesh, BuildReport) {
         let tris = grid.triangles();
         let topo = grid.topology();
         let verts = grid.vertices();
@@ -64,8 +86,8 @@ impl HalfedgeMesh {
             ..Default::default()
         };
         let mut rejected = vec![false; nf];
-        let (corner, origin, split) = loop {
-            let (corner, origin, split) = fans(grid, &rejected);
+        let (corner, origin, split, natural) = loop {
+            let (corner, origin, split, natural) = fans(grid, &rejected, pieces);
             // Two faces claiming one directed edge cannot both be linked.
             let mut claimed: HashMap<u64, u32> = HashMap::with_capacity(3 * nf);
             let mut conflict = false;
@@ -85,13 +107,20 @@ impl HalfedgeMesh {
                 }
             }
             if !conflict {
-                break (corner, origin, split);
+                break (corner, origin, split, natural);
             }
         };
         report.detached_faces = rejected.iter().filter(|&&r| r).count();
-        report.split_vertices = (0..origin.len())
-            .filter(|&i| split[i] && (i == 0 || origin[i - 1] != origin[i]))
-            .count();
+        // An input vertex's copies: several fans of its own (split), or only
+        // because a cut runs through it.
+        let first_copies = (0..origin.len()).filter(|&i| i == 0 || origin[i - 1] != origin[i]);
+        for i in first_copies {
+            if split[i] && natural[origin[i] as usize] > 1 {
+                report.split_vertices += 1;
+            } else if split[i] {
+                report.cut_vertices += 1;
+            }
+        }
 
         let mut mesh = HalfedgeMesh::new();
         let mut seen_origin = vec![false; verts.len()];
@@ -101,7 +130,7 @@ impl HalfedgeMesh {
             if split[i] {
                 mesh.vertex_flags[v as usize] = V_LOCKED | V_CORNER;
             }
-            if seen_origin[o as usize] {
+            if seen_origin[o as usize] && natural[o as usize] > 1 {
                 report.extra_copies += 1;
             }
             seen_origin[o as usize] = true;
@@ -200,16 +229,25 @@ impl HalfedgeMesh {
                     }
                 }
             }
-            // A boundary here that was not one in the input: an orientation seam.
+            // A boundary here that was not one in the input: a cut between
+            // pieces, or else an orientation seam.
             if mesh.is_boundary_edge(e) && nfaces != 1 {
                 flags |= E_FEATURE | E_LOCKED;
+                let ef = topo.faces_of_edge(ie);
+                if let (Some(p), 2) = (pieces, nfaces) {
+                    if p[ef[0] as usize] != p[ef[1] as usize] {
+                        flags |= E_CUT;
+                    }
+                }
             }
             mesh.edge_flags[e as usize] = flags;
         }
         let mut valence = vec![0u32; mesh.n_vertices()];
         for e in 0..mesh.n_edges() as u32 {
             let fl = mesh.edge_flags[e as usize];
-            if fl & E_LOCKED != 0 {
+            if fl & E_CUT != 0 {
+                report.cut_edges += 1;
+            } else if fl & E_LOCKED != 0 {
                 report.locked_edges += 1;
             }
             for v in mesh.edge_vertices(e) {
@@ -233,9 +271,13 @@ impl HalfedgeMesh {
     }
 }
 
-/// One copy per (vertex, fan). Returns the copy at each face corner, the input
-/// vertex of each copy, and whether that input vertex has several fans.
-fn fans(grid: &Grid, rejected: &[bool]) -> (Vec<[u32; 3]>, Vec<u32>, Vec<bool>) {
+/// One copy per (vertex, fan), a fan never crossing from one piece to
+/// another. Returns the copy at each face corner, the input vertex of each
+/// copy, whether that input vertex has several copies, and per input vertex
+/// how many fans it has regardless of the pieces.
+type Fans = (Vec<[u32; 3]>, Vec<u32>, Vec<bool>, Vec<u32>);
+
+fn fans(grid: &Grid, rejected: &[bool], pieces: Option<&[u32]>) -> Fans {
     let tris = grid.triangles();
     let topo = grid.topology();
     let mut corner = vec![[NONE; 3]; tris.len()];
@@ -243,6 +285,16 @@ fn fans(grid: &Grid, rejected: &[bool]) -> (Vec<[u32; 3]>, Vec<u32>, Vec<bool>) 
     let mut split = Vec::with_capacity(grid.vertices().len());
     let mut fs: Vec<u32> = Vec::new();
     let mut parent: Vec<usize> = Vec::new();
+    // The fans as they would be without the pieces (only with pieces).
+    let mut whole: Vec<usize> = Vec::new();
+    let mut natural = vec![
+        1u32;
+        if pieces.is_some() {
+            grid.vertices().len()
+        } else {
+            0
+        }
+    ];
     let mut label: Vec<u32> = Vec::new();
     for v in 0..grid.vertices().len() {
         fs.clear();
@@ -257,6 +309,8 @@ fn fans(grid: &Grid, rejected: &[bool]) -> (Vec<[u32; 3]>, Vec<u32>, Vec<bool>) 
         }
         parent.clear();
         parent.extend(0..fs.len());
+        whole.clear();
+        whole.extend(0..fs.len());
         let v32 = v as u32;
         for (i, &f) in fs.iter().enumerate() {
             let t = tris[f as usize];
@@ -291,6 +345,13 @@ fn fans(grid: &Grid, rejected: &[bool]) -> (Vec<[u32; 3]>, Vec<u32>, Vec<bool>) 
                 let Some(gi) = fs.iter().position(|&x| x == g) else {
                     continue;
                 };
+                let (wa, wb) = (find(&mut whole, i), find(&mut whole, gi));
+                if wa != wb {
+                    whole[wa.max(wb)] = wa.min(wb);
+                }
+                if pieces.is_some_and(|p| p[f as usize] != p[g as usize]) {
+                    continue;
+                }
                 let (ra, rb) = (find(&mut parent, i), find(&mut parent, gi));
                 if ra != rb {
                     parent[ra.max(rb)] = ra.min(rb);
@@ -313,6 +374,16 @@ fn fans(grid: &Grid, rejected: &[bool]) -> (Vec<[u32; 3]>, Vec<u32>, Vec<bool>) 
             corner[f][k] = label[r];
         }
         split.extend(std::iter::repeat_n(count > 1, count as usize));
+        if let Some(n) = natural.get_mut(v) {
+            *n = (0..fs.len()).filter(|&i| find(&mut whole, i) == i).count() as u32;
+        }
     }
-    (corner, origin, split)
+    if pieces.is_none() {
+        // Without pieces the fans are the natural ones.
+        natural = vec![0; grid.vertices().len()];
+        for &o in &origin {
+            natural[o as usize] += 1;
+        }
+    }
+    (corner, origin, split, natural)
 }

@@ -55,6 +55,9 @@ pub const E_FEATURE: u8 = 1;
 /// Edge flag: locked (non-manifold in the input, or unlinkable); never split,
 /// collapsed or flipped.
 pub const E_LOCKED: u8 = 2;
+/// Edge flag: on a cut between pieces of one body
+/// ([`HalfedgeMesh::from_grid_cut`]); also [`E_LOCKED`] and [`E_FEATURE`].
+pub const E_CUT: u8 = 4;
 
 /// A mutable half-edge triangle mesh with tombstones. See the module docs.
 #[derive(Debug, Clone, Default)]
