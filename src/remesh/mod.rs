@@ -316,7 +316,20 @@ fn run(
         .map(|&p| sizes.target(p))
         .collect();
     let thin = thin_patches(input, &features, &widths, &vertex_target);
-    let cut = pieces::pieces(input, &features, &thin, &vertex_target, params.piece_faces);
+    let narrow = narrower_than(
+        input,
+        &features,
+        &widths,
+        &vertex_target,
+        pieces::NARROW_RATIO,
+    );
+    let cut = pieces::pieces(
+        input,
+        &features,
+        &narrow,
+        &vertex_target,
+        params.piece_faces,
+    );
     let (mut mesh, build) =
         HalfedgeMesh::from_grid_cut(input, Some(&features), cut.as_ref().map(|c| &c.piece[..]));
     {
@@ -592,6 +605,17 @@ fn iterate(
 /// perimeter): such a strip cannot hold vertices inside (they would sit on
 /// its rims and make flat faces), so it is remeshed from its rims only.
 fn thin_patches(input: &Grid, features: &Features, width: &[f64], vt: &[f64]) -> Vec<bool> {
+    narrower_than(input, features, width, vt, 0.5)
+}
+
+/// Patches narrower than `ratio` times their least target length.
+fn narrower_than(
+    input: &Grid,
+    features: &Features,
+    width: &[f64],
+    vt: &[f64],
+    ratio: f64,
+) -> Vec<bool> {
     let mut target = vec![f64::INFINITY; width.len()];
     for (f, tri) in input.triangles().iter().enumerate() {
         let p = features.face_patch[f] as usize;
@@ -602,7 +626,7 @@ fn thin_patches(input: &Grid, features: &Features, width: &[f64], vt: &[f64]) ->
     width
         .iter()
         .zip(&target)
-        .map(|(&w, &t)| w < 0.5 * t)
+        .map(|(&w, &t)| w < ratio * t)
         .collect()
 }
 

@@ -43,6 +43,13 @@ use rayon::prelude::*;
 /// module doc).
 pub const MIN_CUT_RATIO: f64 = 0.2;
 
+/// No cut borders a patch narrower than this many target lengths (its width
+/// being twice its area over its perimeter): a strip of fewer than about two
+/// rows of triangles has its free vertices relaxed onto its rims, and on a
+/// locked rim no flip or collapse can undo the flat triangle that makes (seen
+/// on trimesh_fm1_satellite's panel edges, 4 wide against a target of 3.55).
+pub const NARROW_RATIO: f64 = 2.0;
+
 /// A piece expected to make less than this share of `piece_faces` is merged
 /// into a neighbour: its seam would cost more than its thread saves.
 pub const MIN_PIECE_SHARE: f64 = 0.25;
@@ -198,12 +205,12 @@ pub struct Cut {
 /// The pieces of the input (see the module doc), or `None` when no body is
 /// large enough to cut (or no cut survives). `target` holds the target
 /// length at each input vertex; `piece_faces` is the expected output per
-/// piece (not finite or ≤ 0: never cut); `thin` flags the patches too
-/// narrow to hold vertices, which no cut may border. O(F + P log² P).
+/// piece (not finite or ≤ 0: never cut); `narrow` flags the patches no cut
+/// may border (narrower than [`NARROW_RATIO`] targets). O(F + P log² P).
 pub fn pieces(
     input: &Grid,
     features: &Features,
-    thin: &[bool],
+    narrow: &[bool],
     target: &[f64],
     piece_faces: f64,
 ) -> Option<Cut> {
@@ -285,14 +292,14 @@ pub fn pieces(
         // The faces across the cut are not needles along it: their
         // heights over it (twice the area over the length) pass the same
         // bound, or the pre-split fans them into slivers that no flip may
-        // fix across a locked edge; nor does a cut border a strip too
-        // narrow for vertices inside (its triangles span from rim to rim,
-        // and a locked rim left zero-area ones on trimesh_fm1_satellite).
+        // fix across a locked edge; nor does a cut border a narrow strip
+        // ([`NARROW_RATIO`]).
         let height = |f: u32| 2.0 * per_face[f as usize].1 / len;
-        let thin_face = |f: u32| thin.get(features.face_patch[f as usize] as usize) == Some(&true);
+        let narrow_face =
+            |f: u32| narrow.get(features.face_patch[f as usize] as usize) == Some(&true);
         let good = features.is_feature(e)
-            && !thin_face(ef[0])
-            && !thin_face(ef[1])
+            && !narrow_face(ef[0])
+            && !narrow_face(ef[1])
             && len >= least
             && height(ef[0]) >= least
             && height(ef[1]) >= least;
