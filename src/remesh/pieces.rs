@@ -18,8 +18,10 @@
 //! the remesher keeps anyway, and not shorter than [`MIN_CUT_RATIO`] of its
 //! target (a triangle on a base of a fifth of its two other sides has an
 //! 11.5° apex, above the 10° a collapse may not go below, the remesher's
-//! `sliver_angle_deg`). Two pieces that meet along any shorter edge are merged
-//! again, so a body whose creases are all finely tessellated stays whole;
+//! `sliver_angle_deg`), with the faces on both sides at least that high over
+//! it and neither in a patch narrower than [`NARROW_RATIO`] targets. Two
+//! pieces that meet along any other edge are merged again, so a body whose
+//! creases are all finely tessellated stays whole;
 //! then every piece below [`MIN_PIECE_SHARE`] of `piece_faces` is merged
 //! into its smallest neighbour, so a body whose area lies in one large
 //! patch ringed by small ones stays whole too. Pieces that meet at a
@@ -33,7 +35,14 @@
 //! against remeshing the body whole: its crease vertices stay where the
 //! input and the pre-split put them instead of sliding along the line.
 //!
-//! Cost: O(F + P log² P) for F input faces and P patches.
+//! **Unstable.** Off by default (`RemeshParams::piece_faces` infinite): on
+//! trimesh_fm1_satellite free vertices still end on a locked crease of a
+//! cut and make flat triangles, which the remesher then undoes by
+//! remeshing whole (its safety net: zero-area triangles dropped, or the
+//! bodies changed).
+//!
+//! Cost: O(F + P log² P) for F input faces and P patches, plus O(F) per
+//! merge of a small piece (a few per cut body).
 
 use crate::geometry::{cross, norm, sub};
 use crate::mesh::{Features, Grid};
