@@ -316,20 +316,23 @@ fn run(
         .map(|&p| sizes.target(p))
         .collect();
     let thin = thin_patches(input, &features, &widths, &vertex_target);
-    let narrow = narrower_than(
-        input,
-        &features,
-        &widths,
-        &vertex_target,
-        pieces::NARROW_RATIO,
-    );
-    let cut = pieces::pieces(
-        input,
-        &features,
-        &narrow,
-        &vertex_target,
-        params.piece_faces,
-    );
+    let cut = params.piece_faces.is_finite().then(|| {
+        let narrow = narrower_than(
+            input,
+            &features,
+            &widths,
+            &vertex_target,
+            pieces::NARROW_RATIO,
+        );
+        pieces::pieces(
+            input,
+            &features,
+            &narrow,
+            &vertex_target,
+            params.piece_faces,
+        )
+    });
+    let cut = cut.flatten();
     let (mut mesh, build) =
         HalfedgeMesh::from_grid_cut(input, Some(&features), cut.as_ref().map(|c| &c.piece[..]));
     {

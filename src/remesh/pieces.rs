@@ -45,6 +45,7 @@
 //! merge of a small piece (a few per cut body).
 
 use crate::geometry::{cross, norm, sub};
+use crate::mesh::topology::{find as root, union};
 use crate::mesh::{Features, Grid};
 use rayon::prelude::*;
 
@@ -53,10 +54,12 @@ use rayon::prelude::*;
 pub const MIN_CUT_RATIO: f64 = 0.2;
 
 /// No cut borders a patch narrower than this many target lengths (its width
-/// being twice its area over its perimeter): a strip of fewer than about two
-/// rows of triangles has its free vertices relaxed onto its rims, and on a
-/// locked rim no flip or collapse can undo the flat triangle that makes (seen
-/// on trimesh_fm1_satellite's panel edges, 4 wide against a target of 3.55).
+/// being twice its area over its perimeter), a strip of fewer than about two
+/// rows of triangles. A guard, not a proof: on trimesh_fm1_satellite free
+/// vertices ended exactly on locked creases of a cut, in flat triangles that
+/// no flip or collapse may undo across a locked edge, and this rule took its
+/// zero-area triangles from 350 to 140, not to none (how the vertices get
+/// there was not traced).
 pub const NARROW_RATIO: f64 = 2.0;
 
 /// A piece expected to make less than this share of `piece_faces` is merged
@@ -72,15 +75,6 @@ pub fn expected(area: f64, l: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// Union-find root with path halving.
-fn root(p: &mut [u32], mut x: u32) -> u32 {
-    while p[x as usize] != x {
-        p[x as usize] = p[p[x as usize] as usize];
-        x = p[x as usize];
-    }
-    x
 }
 
 /// A patch's weight (expected faces) and area-weighted centroid.
@@ -191,9 +185,10 @@ fn untangle(
         if simple && cuts <= roots.len() {
             continue;
         }
+        // The lowest root stays the root of the union.
         let lo = roots[0];
         for &r in &roots[1..] {
-            parent[r as usize] = lo;
+            union(parent, lo, r);
             weight[lo as usize] += weight[r as usize];
         }
         changed = true;
@@ -313,10 +308,7 @@ pub fn pieces(
             && height(ef[0]) >= least
             && height(ef[1]) >= least;
         if !good {
-            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-            if ra != rb {
-                parent[ra.max(rb) as usize] = ra.min(rb);
-            }
+            union(&mut parent, a, b);
         }
     }
     // A piece below a quarter of `piece_faces` is not worth its seam: merge
@@ -371,10 +363,12 @@ pub fn pieces(
                 weight[a as usize]
                     .total_cmp(&weight[b as usize])
                     .then(a.cmp(&b))
-            })
-            .expect("a root listed in a cut has a neighbour");
+            });
+        let Some(other) = other else {
+            break;
+        };
         let (lo, hi) = (r.min(other), r.max(other));
-        parent[hi as usize] = lo;
+        union(&mut parent, lo, hi);
         weight[lo as usize] += weight[hi as usize];
     }
     // Number by first face; count the pieces of each body.
