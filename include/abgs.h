@@ -918,8 +918,11 @@ abgs_status abgs_remesh_params_default(abgs_remesh_params *out_params);
 // is not an error: what was left as it was is counted in `n_issues`.
 // `input` and `sizing` are only read (other const calls may run on them
 // meanwhile; a mutating call on them returns BUSY until this one returns).
-// Cost: O(F log F) per iteration, parallel on the rayon thread pool; the result
-// does not depend on the thread count.
+// Cost: O(F log F) per iteration, parallel on the rayon thread pool: bodies
+// side by side, and a body expected to make more than 100,000 triangles cut
+// along its creases into pieces of about 50,000 that run side by side too
+// (README "Large bodies in pieces"). The result does not depend on the
+// thread count.
 //
 // Errors: NULL (input, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
 // NO_SIZES (a sizing grid without sizes), BUSY (a mutation is running on

@@ -29,10 +29,10 @@ pub struct GridArgs {
     /// Elements per full circle in the curvature cap.
     #[arg(long, default_value_t = 24.0)]
     pub n_circle: f64,
-    /// Unstable, opt-in: a body expected to make more than twice this many
-    /// triangles is cut along its creases into pieces remeshed side by side
-    /// (e.g. 50000; default "inf": never; see README "Large bodies in pieces").
-    #[arg(long, default_value_t = f64::INFINITY)]
+    /// A body expected to make more than twice this many triangles is cut
+    /// along its creases into pieces remeshed side by side ("inf": never;
+    /// see README "Large bodies in pieces").
+    #[arg(long, default_value_t = abgs::remesh::pieces::DEFAULT_PIECE_FACES)]
     pub piece_faces: f64,
     /// Size-driven mode: target lengths from this grid's sizes (point array `size`,
     /// e.g. the VTK written by `abgs size`).

@@ -28,11 +28,10 @@ pub struct RunArgs {
     /// Elements per full circle (curvature sizes and the dense grid's curvature cap).
     #[arg(long, default_value_t = 24.0)]
     pub n_circle: f64,
-    /// Dense grid, unstable, opt-in: a body expected to make more than twice
-    /// this many triangles is cut along its creases into pieces remeshed side
-    /// by side (e.g. 50000; default "inf": never; see README "Large bodies in
-    /// pieces").
-    #[arg(long, default_value_t = f64::INFINITY)]
+    /// Dense grid: a body expected to make more than twice this many
+    /// triangles is cut along its creases into pieces remeshed side by side
+    /// ("inf": never; see README "Large bodies in pieces").
+    #[arg(long, default_value_t = abgs::remesh::pieces::DEFAULT_PIECE_FACES)]
     pub piece_faces: f64,
     /// Elements across a gap or wall.
     #[arg(long, default_value_t = 3.0)]

@@ -44,13 +44,13 @@ pub fn presplit(
         } else {
             (mesh.positions[b as usize], mesh.positions[a as usize])
         };
-        let len = norm(sub(pa, pb));
-        let t = target(lerp(pa, pb, 0.5));
-        if !(t > 0.0 && len > t) {
+        let ends = [target(pa), target(pb)];
+        let mut points: Vec<([f64; 3], f64)> = Vec::new();
+        graded(&target, pa, pb, ends, 0, &mut points);
+        if points.is_empty() {
             continue;
         }
-        let k = ((len / t).ceil() as usize).clamp(2, 1 << 16);
-        let points: Vec<[f64; 3]> = (1..k).map(|i| lerp(pa, pb, i as f64 / k as f64)).collect();
+        let k = points.len() + 1;
         let ids: Vec<u32> = (0..k as u32 - 1).map(|i| origin + i).collect();
         origin += k as u32 - 1;
         for &e in &edges {
@@ -61,8 +61,8 @@ pub fn presplit(
                 (y, x)
             };
             let mut cur = e;
-            for (p, &id) in points.iter().zip(&ids) {
-                let v = mesh.split(cur, *p);
+            for (&(p, t), &id) in points.iter().zip(&ids) {
+                let v = mesh.split(cur, p);
                 mesh.vertex_flags[v as usize] = V_LOCKED | V_CORNER | V_FEATURE;
                 mesh.vertex_origin[v as usize] = id;
                 mesh.vertex_size[v as usize] = t;
@@ -78,4 +78,85 @@ pub fn presplit(
         }
     }
     pieces
+}
+
+/// Deepest bisection of one locked edge: 2¹⁶ pieces at most.
+const MAX_LEVELS: u32 = 16;
+
+/// The points (with their targets) that cut the segment `pa`–`pb`, whose
+/// ends have the targets `ends`, into pieces each no longer than the least
+/// of its ends' mean target and its midpoint's: bisected while a piece is
+/// longer, so a long edge across a change of target is graded like a
+/// feature line the remesher splits, not cut evenly to its midpoint's
+/// target (which left pieces several times the target near one end, and
+/// flat triangles against them). Points in order from `pa`.
+fn graded(
+    target: &impl Fn([f64; 3]) -> f64,
+    pa: [f64; 3],
+    pb: [f64; 3],
+    ends: [f64; 2],
+    level: u32,
+    out: &mut Vec<([f64; 3], f64)>,
+) {
+    let mid = lerp(pa, pb, 0.5);
+    let tm = target(mid);
+    let t = tm.min(0.5 * (ends[0] + ends[1]));
+    if level >= MAX_LEVELS || !(t > 0.0 && norm(sub(pa, pb)) > t) {
+        return;
+    }
+    graded(target, pa, mid, [ends[0], tm], level + 1, out);
+    out.push((mid, tm));
+    graded(target, mid, pb, [tm, ends[1]], level + 1, out);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pieces of a segment, with the targets at its two ends.
+    fn pieces(target: impl Fn([f64; 3]) -> f64, len: f64) -> Vec<(f64, f64, f64)> {
+        let (pa, pb) = ([0.0; 3], [len, 0.0, 0.0]);
+        let mut points = vec![(pa, target(pa))];
+        graded(&target, pa, pb, [target(pa), target(pb)], 0, &mut points);
+        points.push((pb, target(pb)));
+        points
+            .windows(2)
+            .map(|w| (norm(sub(w[1].0, w[0].0)), w[0].1, w[1].1))
+            .collect()
+    }
+
+    #[test]
+    fn a_locked_edge_is_cut_to_the_target_along_it_not_at_its_midpoint() {
+        // The target falls from 4 to 0.25 over a 16-long edge: the even cut
+        // to the midpoint's target (2.1) made pieces of 2, eight times the
+        // target at the near end.
+        let t = |p: [f64; 3]| 0.25 + 3.75 * (p[0] / 16.0);
+        let ps = pieces(t, 16.0);
+        let total: f64 = ps.iter().map(|x| x.0).sum();
+        assert!((total - 16.0).abs() < 1e-12);
+        for &(l, ta, tb) in &ps {
+            assert!(
+                l <= 0.5 * (ta + tb) * (1.0 + 1e-12),
+                "{l} against {ta}, {tb}"
+            );
+        }
+        let first = ps[0];
+        assert!(first.0 <= 0.5, "first piece {first:?}");
+        // No much finer than needed: a piece is halved only when over its
+        // bound, which changes little from a piece to its halves here.
+        for &(l, ta, tb) in &ps {
+            assert!(l > 0.2 * (ta + tb), "{l} against {ta}, {tb}");
+        }
+    }
+
+    #[test]
+    fn an_edge_within_its_target_is_not_cut_and_a_uniform_one_evenly() {
+        assert!(pieces(|_| 2.0, 1.5).len() == 1);
+        let ps = pieces(|_| 1.0, 3.9);
+        assert_eq!(ps.len(), 4);
+        assert!(ps.iter().all(|x| (x.0 - 0.975).abs() < 1e-12));
+        // A target that is not positive or not finite cuts nothing.
+        assert_eq!(pieces(|_| 0.0, 3.0).len(), 1);
+        assert_eq!(pieces(|_| f64::NAN, 3.0).len(), 1);
+    }
 }

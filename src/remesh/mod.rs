@@ -28,8 +28,8 @@
 //! (`expected_faces`), and within a part
 //! relaxation and projection run in parallel; a part's topological passes
 //! are sequential, so a single large body gains only from the latter,
-//! unless [`RemeshParams::piece_faces`] (unstable, opt-in) cuts it along
-//! its creases into pieces that are parts of their own ([`pieces`]). The
+//! unless it is large enough for [`RemeshParams::piece_faces`] to cut it
+//! along its creases into pieces that are parts of their own ([`pieces`]). The
 //! output does not depend on the thread count.
 
 mod field;
@@ -94,12 +94,13 @@ pub struct RemeshParams {
     /// A collapse may remove a vertex only if it lies within this fraction of
     /// the local target length of the surface (and feature line) left (0.05).
     pub fidelity: f64,
-    /// **Unstable, opt-in.** A body expected to make more than twice this
-    /// many triangles is cut along its creases into pieces of about this
-    /// many, remeshed side by side ([`pieces`]; default infinite: never
-    /// cut). The pieces do not depend on the thread count, but the grid
-    /// differs from the whole body's; a cut that leaves zero-area triangles
-    /// or changes the bodies is undone (remeshed whole, at twice the cost).
+    /// A body expected to make more than twice this many triangles is cut
+    /// along its creases into pieces of about this many, remeshed side by
+    /// side ([`pieces`]; default [`pieces::DEFAULT_PIECE_FACES`]; infinite:
+    /// never cut). The pieces do not depend on the thread count, but the
+    /// grid differs from the whole body's; a cut that leaves zero-area
+    /// triangles or changes the bodies is undone (remeshed whole, at twice
+    /// the cost).
     pub piece_faces: f64,
 }
 
@@ -119,7 +120,7 @@ impl Default for RemeshParams {
             max_normal_turn_deg: 60.0,
             sliver_angle_deg: 10.0,
             fidelity: 0.05,
-            piece_faces: f64::INFINITY,
+            piece_faces: pieces::DEFAULT_PIECE_FACES,
         }
     }
 }

@@ -35,11 +35,18 @@
 //! against remeshing the body whole: its crease vertices stay where the
 //! input and the pre-split put them instead of sliding along the line.
 //!
-//! **Unstable.** Off by default (`RemeshParams::piece_faces` infinite): on
-//! trimesh_fm1_satellite free vertices still end on a locked crease of a
-//! cut and make flat triangles, which the remesher then undoes by
-//! remeshing whole (its safety net: zero-area triangles dropped, or the
-//! bodies changed).
+//! **Seams.** A cut crease is pre-split like the edges where bodies touch,
+//! graded by the targets along it (`locked::presplit`). An earlier
+//! pre-split cut each edge evenly to its midpoint's target; on
+//! trimesh_fm1_satellite that left locked pieces several times the target
+//! at one end, free vertices split and projected exactly onto them, and
+//! flat triangles that no flip or collapse may undo across a locked edge.
+//! Graded, the satellite's five pieces leave none. The remesher keeps a
+//! safety net all the same: a cut whose output drops zero-area triangles
+//! or changes the number of bodies is undone by remeshing whole.
+//!
+//! **Default.** On, with pieces of [`DEFAULT_PIECE_FACES`] (infinite
+//! `RemeshParams::piece_faces` never cuts).
 //!
 //! Cost: O(F + P log² P) for F input faces and P patches, plus O(F) per
 //! merge of a small piece (a few per cut body).
@@ -49,17 +56,27 @@ use crate::mesh::topology::{find as root, union};
 use crate::mesh::{Features, Grid};
 use rayon::prelude::*;
 
+/// The default `RemeshParams::piece_faces`: a body expected to make more
+/// than twice this many triangles is cut. A piece's seam pins its crease
+/// vertices: a square piece of N triangles has a side of about √(N/2)
+/// edges, so at 50,000 about 1.3 % of its triangles touch the seam, and a
+/// smaller piece pins a larger share. A body below two pieces is remeshed
+/// in seconds on one thread (trimesh_featuretype, 121k triangles: 7.3 s
+/// here), so smaller pieces would buy little time for more seam. The
+/// value is a count of output triangles, so it means the same at any
+/// scale of model or target.
+pub const DEFAULT_PIECE_FACES: f64 = 50_000.0;
+
 /// A cut edge must be at least this fraction of its target length (see the
 /// module doc).
 pub const MIN_CUT_RATIO: f64 = 0.2;
 
 /// No cut borders a patch narrower than this many target lengths (its width
 /// being twice its area over its perimeter), a strip of fewer than about two
-/// rows of triangles. A guard, not a proof: on trimesh_fm1_satellite free
-/// vertices ended exactly on locked creases of a cut, in flat triangles that
-/// no flip or collapse may undo across a locked edge, and this rule took its
-/// zero-area triangles from 350 to 140, not to none (how the vertices get
-/// there was not traced).
+/// rows of triangles: there a free vertex has no room to keep off the locked
+/// crease. A margin: it came before the graded pre-split (see the module
+/// doc's *Seams*) and took the satellite's zero-area triangles of the even
+/// pre-split from 350 to 140; the graded pre-split takes them to none.
 pub const NARROW_RATIO: f64 = 2.0;
 
 /// A piece expected to make less than this share of `piece_faces` is merged
