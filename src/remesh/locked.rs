@@ -1,18 +1,26 @@
-//! Locked edges (non-manifold in the input: bodies touching along them) are
-//! never changed by the local operations, but one longer than its target
-//! would force ever flatter triangles against it. So before remeshing each is
-//! cut into pieces no longer than its target, identically in every body that
-//! shares it (same points, same new locked vertex ids), so the copies still
-//! merge into one non-manifold polyline on output.
+//! Locked edges (non-manifold in the input: bodies touching along them, and
+//! the creases where a large body is cut into pieces) are never changed by
+//! the local operations, but one longer than its target would force ever
+//! flatter triangles against it. So before remeshing each is cut into
+//! pieces no longer than the target along it, graded where the target
+//! changes (a piece several targets long at one end let splits put free
+//! vertices exactly on it, in flat triangles nothing may undo),
+//! identically in every body or piece that shares it (same points, same new
+//! locked vertex ids), so the copies still merge into one non-manifold
+//! polyline, or one seam, on output.
 
 use crate::geometry::{lerp, norm, sub};
 use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED, NONE, V_CORNER, V_FEATURE, V_LOCKED};
 use std::collections::BTreeMap;
 
-/// Splits every locked edge longer than `target` (at its midpoint) into equal
-/// pieces; new vertices are locked corners with origins numbered from
-/// `next_origin` up, shared by the copies of one input edge. Returns the
-/// number of new pieces.
+/// Splits every locked edge longer than `target` along it into pieces graded
+/// by the target ([`graded`]: bisection while a piece is longer than the
+/// least of its midpoint's target and its ends' mean); new vertices are
+/// locked corners with their own target as size and origins numbered from
+/// `next_origin` up, shared by the copies of one input edge (the points are
+/// computed once per input edge, from the end of lower origin, so every
+/// copy is cut at the same points). Returns the number of new pieces.
+/// Cost: O(pieces) target evaluations and splits.
 pub fn presplit(
     mesh: &mut HalfedgeMesh,
     target: impl Fn([f64; 3]) -> f64,
