@@ -52,6 +52,7 @@ int main(void) {
     CHECK_STATUS(abgs_remesh_params_default(&p), ABGS_OK);
     CHECK(p.edge_length == 0.0 && p.relative_length == 0.01 && p.feature_angle_deg == 30.0);
     CHECK(p.iterations == 10 && p.curvature_limit == 1 && p.n_circle == 24.0);
+    CHECK(p.piece_faces == 50000.0);
     CHECK_STATUS(abgs_remesh_params_default(NULL), ABGS_ERR_NULL);
 
     abgs_grid *cube = NULL;
@@ -72,6 +73,7 @@ int main(void) {
     CHECK(r.feature_edges_out >= 12 * 8);
     CHECK(r.iterations == 10 && r.seconds >= 0.0 && r.seconds < 600.0);
     CHECK(r.n_issues == 0);
+    CHECK(r.pieces == 0); /* about 1,400 triangles: far below two pieces */
     size_t nv = 0, nt = 0;
     double *xyz = NULL;
     uint32_t *tris = NULL;
@@ -91,6 +93,27 @@ int main(void) {
     CHECK_STATUS(abgs_grid_get_stats(dense, &st), ABGS_OK);
     CHECK(st.bodies == 1 && st.boundary_edges == 0 && st.non_manifold_edges == 0);
     CHECK(st.has_sizes == 0);
+
+    /* Pieces of about 200 triangles: the cube (about 1,400) is cut along its
+       edges, and the pieces merge back into one closed body. */
+    {
+        abgs_remesh_params pp = p;
+        pp.piece_faces = 200.0;
+        abgs_remesh_report rp = {.struct_size = sizeof rp};
+        abgs_grid *cut = NULL;
+        CHECK_STATUS(abgs_grid_remesh(cube, NULL, &pp, &cut, &rp), ABGS_OK);
+        CHECK(rp.pieces >= 2 && rp.n_issues == 0);
+        CHECK(rp.faces_out > 600 && rp.faces_out < 5000);
+        abgs_grid_stats sc = {.struct_size = sizeof sc};
+        CHECK_STATUS(abgs_grid_get_stats(cut, &sc), ABGS_OK);
+        CHECK(sc.bodies == 1 && sc.boundary_edges == 0 && sc.non_manifold_edges == 0);
+        CHECK_STATUS(abgs_grid_free(cut), ABGS_OK);
+        /* 0 = never cut. */
+        pp.piece_faces = 0.0;
+        CHECK_STATUS(abgs_grid_remesh(cube, NULL, &pp, &cut, &rp), ABGS_OK);
+        CHECK(rp.pieces == 0 && rp.faces_out == r.faces_out);
+        CHECK_STATUS(abgs_grid_free(cut), ABGS_OK);
+    }
 
     /* The kept feature edges run along the cube's edges. */
     size_t nfe = 0;
@@ -272,6 +295,16 @@ int main(void) {
     CHECK_STATUS(abgs_grid_remesh(cube, NULL, &bad, &o, NULL), ABGS_ERR_INVALID_ARGUMENT);
     bad = p; bad.n_circle = -INFINITY;
     CHECK_STATUS(abgs_grid_remesh(cube, NULL, &bad, &o, NULL), ABGS_ERR_NON_FINITE);
+    /* piece_faces: >= 0 and finite (0 = never cut). */
+    const double bad_pieces[3] = {-1.0, NAN, INFINITY};
+    const abgs_status bad_pieces_status[3] = {ABGS_ERR_INVALID_ARGUMENT, ABGS_ERR_NON_FINITE,
+                                              ABGS_ERR_NON_FINITE};
+    for (int i = 0; i < 3; i++) {
+        bad = p;
+        bad.piece_faces = bad_pieces[i];
+        CHECK_STATUS(abgs_grid_remesh(cube, NULL, &bad, &o, NULL), bad_pieces_status[i]);
+        CHECK(strstr(abgs_last_error_message(), "piece_faces") != NULL && o == NULL);
+    }
     /* Bad parameters are errors in size-driven mode too. */
     bad = p; bad.edge_length = -1.0;
     CHECK_STATUS(abgs_grid_remesh(cube, sizing, &bad, &o, NULL), ABGS_ERR_INVALID_ARGUMENT);

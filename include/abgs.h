@@ -326,6 +326,13 @@ typedef struct {
   int32_t curvature_limit;
   // Elements per full circle in that curvature size, in (0, 1e9] (default 24).
   double n_circle;
+  // A body expected to make more than twice this many triangles is cut
+  // along its creases into pieces of about this many, remeshed side by
+  // side (README "Large bodies in pieces"); the pieces do not depend on
+  // the thread count. >= 0; 0 = never cut (default 50000). Added after
+  // the first release: a caller whose `struct_size` ends before it gets
+  // the default.
+  double piece_faces;
 } abgs_remesh_params;
 
 // What `abgs_grid_remesh` did.
@@ -361,6 +368,9 @@ typedef struct {
   // Number of things that could not be remeshed (0 when everything was);
   // their texts come from `abgs_grid_remesh_issue`.
   uint64_t n_issues;
+  // Pieces the large bodies were cut into (0 when none was cut; see
+  // `piece_faces`). Added after the first release.
+  uint64_t pieces;
 } abgs_remesh_report;
 
 // What one iteration did (given to the progress callback, and readable

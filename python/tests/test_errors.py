@@ -110,6 +110,8 @@ def test_parameter_errors() -> None:
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.remesh(iterations=0))
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.remesh(feature_angle_deg=200.0))
     raises(E.ERR_NON_FINITE, lambda: g.remesh(edge_length=math.inf))
+    raises(E.ERR_INVALID_ARGUMENT, lambda: g.remesh(piece_faces=-1.0))
+    raises(E.ERR_NON_FINITE, lambda: g.remesh(piece_faces=math.inf))
     raises(E.ERR_INVALID_ARGUMENT, lambda: g.compute_sizes(beta=0.9))
     raises(E.ERR_INVALID_SIZE, lambda: g.compute_sizes(sources=[abgs.point_source([0, 0, 0], -1.0, 1.0)]))
     raises(E.ERR_INVALID_ARGUMENT, lambda: abgs.evaluate(g, g, samples=0))

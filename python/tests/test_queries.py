@@ -183,3 +183,20 @@ def test_bytes_round_trip(coarse: abgs.Grid, points: np.ndarray) -> None:
         pass
     else:
         raise AssertionError("truncated bytes were accepted")
+
+
+def test_remesh_in_pieces() -> None:
+    """A unit cube at edge length 0.1 (about 1,400 triangles) in pieces of
+    about 200 is cut along its edges and comes out closed, in one body;
+    ``piece_faces=0`` never cuts."""
+    v = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]]
+    t = [[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
+         [3, 7, 6], [3, 6, 2], [0, 4, 7], [0, 7, 3], [1, 2, 6], [1, 6, 5]]
+    cube = abgs.Grid.from_arrays(np.array(v, dtype=np.float64), np.array(t, dtype=np.uint32))
+    whole = cube.remesh(edge_length=0.1, piece_faces=0)
+    cut = cube.remesh(edge_length=0.1, piece_faces=200)
+    assert whole.remesh_report.pieces == 0
+    assert cut.remesh_report.pieces >= 2
+    for g in (whole, cut):
+        s = g.stats
+        assert (s.bodies, s.boundary_edges, s.non_manifold_edges) == (1, 0, 0)

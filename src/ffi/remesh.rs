@@ -34,6 +34,13 @@ pub struct abgs_remesh_params {
     pub curvature_limit: i32,
     /// Elements per full circle in that curvature size, in (0, 1e9] (default 24).
     pub n_circle: f64,
+    /// A body expected to make more than twice this many triangles is cut
+    /// along its creases into pieces of about this many, remeshed side by
+    /// side (README "Large bodies in pieces"); the pieces do not depend on
+    /// the thread count. >= 0; 0 = never cut (default 50000). Added after
+    /// the first release: a caller whose `struct_size` ends before it gets
+    /// the default.
+    pub piece_faces: f64,
 }
 
 /// What `abgs_grid_remesh` did.
@@ -71,6 +78,9 @@ pub struct abgs_remesh_report {
     /// Number of things that could not be remeshed (0 when everything was);
     /// their texts come from `abgs_grid_remesh_issue`.
     pub n_issues: u64,
+    /// Pieces the large bodies were cut into (0 when none was cut; see
+    /// `piece_faces`). Added after the first release.
+    pub pieces: u64,
 }
 
 versioned!(abgs_remesh_params, 48, default_params());
@@ -100,6 +110,7 @@ fn default_params() -> abgs_remesh_params {
         iterations: d.iterations as u32,
         curvature_limit: d.curvature_limit as i32,
         n_circle: d.n_circle,
+        piece_faces: d.piece_faces,
     }
 }
 
@@ -127,6 +138,7 @@ fn to_params(p: &abgs_remesh_params) -> FfiResult<RemeshParams> {
         (p.relative_length, "relative_length"),
         (p.feature_angle_deg, "feature_angle_deg"),
         (p.n_circle, "n_circle"),
+        (p.piece_faces, "piece_faces"),
     ] {
         if !x.is_finite() {
             return err(
@@ -160,6 +172,12 @@ fn to_params(p: &abgs_remesh_params) -> FfiResult<RemeshParams> {
     if !(p.n_circle > 0.0 && p.n_circle <= 1e9) {
         return invalid(format!("n_circle = {} must be in (0, 1e9]", p.n_circle));
     }
+    if p.piece_faces < 0.0 {
+        return invalid(format!(
+            "piece_faces = {} must be >= 0 (0: never cut)",
+            p.piece_faces
+        ));
+    }
     Ok(RemeshParams {
         target: if p.edge_length > 0.0 {
             TargetLength::Absolute(p.edge_length)
@@ -170,6 +188,11 @@ fn to_params(p: &abgs_remesh_params) -> FfiResult<RemeshParams> {
         iterations: p.iterations as usize,
         curvature_limit: p.curvature_limit != 0,
         n_circle: p.n_circle,
+        piece_faces: if p.piece_faces == 0.0 {
+            f64::INFINITY
+        } else {
+            p.piece_faces
+        },
         ..Default::default()
     })
 }
@@ -282,6 +305,7 @@ fn report(r: &remesh::Remeshed) -> abgs_remesh_report {
         iterations: p.iterations.len() as u64,
         seconds: p.seconds,
         n_issues: p.issues.len() as u64,
+        pieces: p.pieces as u64,
     }
 }
 

@@ -256,6 +256,7 @@ class RemeshParams(_Struct):
         ("iterations", c_uint32),
         ("curvature_limit", c_int32),
         ("n_circle", c_double),
+        ("piece_faces", c_double),
     ]
 
 
@@ -263,7 +264,8 @@ class RemeshReport(_Struct):
     """What ``abgs_grid_remesh`` did: ``vertices_in``, ``faces_in``,
     ``vertices_out``, ``faces_out``, ``target_length`` (NaN when size-driven),
     ``target_min``, ``target_max``, ``feature_edges_in``, ``feature_edges_out``,
-    ``feature_lines``, ``corners``, ``iterations``, ``seconds``, ``n_issues``."""
+    ``feature_lines``, ``corners``, ``iterations``, ``seconds``, ``n_issues``,
+    ``pieces`` (large bodies cut into pieces; 0 when none was)."""
 
     _fields_ = [
         ("struct_size", c_uint32),
@@ -281,6 +283,7 @@ class RemeshReport(_Struct):
         ("iterations", c_uint64),
         ("seconds", c_double),
         ("n_issues", c_uint64),
+        ("pieces", c_uint64),
     ]
 
 

@@ -472,6 +472,7 @@ class Grid:
         iterations: int | None = None,
         curvature_limit: bool | None = None,
         n_circle: float | None = None,
+        piece_faces: float | None = None,
         sizing: Grid | None = None,
     ) -> Grid:
         """The dense grid: this surface isotropically remeshed (split, collapse,
@@ -485,7 +486,10 @@ class Grid:
         (``sizing`` must carry sizes; it may be this grid). ``curvature_limit``
         (default on) caps the target at half the curvature size with
         ``n_circle`` (24) elements per circle; ``feature_angle_deg`` (30),
-        ``iterations`` (10). O(F log F) per iteration, parallel, deterministic.
+        ``iterations`` (10). A body expected to make more than twice
+        ``piece_faces`` (50000; 0: never) triangles is cut along its creases
+        into pieces remeshed side by side. O(F log F) per iteration,
+        parallel, deterministic.
         """
         p = _defaults(RemeshParams, lib.abgs_remesh_params_default, locals())
         rep = RemeshReport()
