@@ -295,11 +295,11 @@ int main(void) {
     CHECK_STATUS(abgs_grid_remesh(cube, NULL, &bad, &o, NULL), ABGS_ERR_INVALID_ARGUMENT);
     bad = p; bad.n_circle = -INFINITY;
     CHECK_STATUS(abgs_grid_remesh(cube, NULL, &bad, &o, NULL), ABGS_ERR_NON_FINITE);
-    /* piece_faces: >= 0 and finite (0 = never cut). */
-    const double bad_pieces[3] = {-1.0, NAN, INFINITY};
-    const abgs_status bad_pieces_status[3] = {ABGS_ERR_INVALID_ARGUMENT, ABGS_ERR_NON_FINITE,
-                                              ABGS_ERR_NON_FINITE};
-    for (int i = 0; i < 3; i++) {
+    /* piece_faces: 0 (never cut) or finite and >= 1. */
+    const double bad_pieces[4] = {-1.0, 0.5, NAN, INFINITY};
+    const abgs_status bad_pieces_status[4] = {ABGS_ERR_INVALID_ARGUMENT, ABGS_ERR_INVALID_ARGUMENT,
+                                              ABGS_ERR_NON_FINITE, ABGS_ERR_NON_FINITE};
+    for (int i = 0; i < 4; i++) {
         bad = p;
         bad.piece_faces = bad_pieces[i];
         CHECK_STATUS(abgs_grid_remesh(cube, NULL, &bad, &o, NULL), bad_pieces_status[i]);

@@ -329,9 +329,10 @@ typedef struct {
   // A body expected to make more than twice this many triangles is cut
   // along its creases into pieces of about this many, remeshed side by
   // side (README "Large bodies in pieces"); the pieces do not depend on
-  // the thread count. >= 0; 0 = never cut (default 50000). Added after
-  // the first release: a caller whose `struct_size` ends before it gets
-  // the default.
+  // the thread count. 0 = never cut, else >= 1 (default 50000). Added
+  // after the first release: a caller whose `struct_size` ends before it
+  // gets the default, so grids of bodies that large differ from those of
+  // earlier versions.
   double piece_faces;
 } abgs_remesh_params;
 
@@ -369,7 +370,9 @@ typedef struct {
   // their texts come from `abgs_grid_remesh_issue`.
   uint64_t n_issues;
   // Pieces the large bodies were cut into (0 when none was cut; see
-  // `piece_faces`). Added after the first release.
+  // `piece_faces`). A cut whose seams would leave zero-area triangles is
+  // undone (remeshed whole): then 0, and `n_issues` counts the undoing.
+  // Added after the first release.
   uint64_t pieces;
 } abgs_remesh_report;
 
@@ -929,10 +932,10 @@ abgs_status abgs_remesh_params_default(abgs_remesh_params *out_params);
 // `input` and `sizing` are only read (other const calls may run on them
 // meanwhile; a mutating call on them returns BUSY until this one returns).
 // Cost: O(F log F) per iteration, parallel on the rayon thread pool: bodies
-// side by side, and a body expected to make more than 100,000 triangles cut
-// along its creases into pieces of about 50,000 that run side by side too
-// (README "Large bodies in pieces"). The result does not depend on the
-// thread count.
+// side by side, and a body expected to make more than 2 × `piece_faces`
+// (default 50,000) triangles cut along its creases into pieces that run
+// side by side too (README "Large bodies in pieces"). The result does not
+// depend on the thread count.
 //
 // Errors: NULL (input, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
 // NO_SIZES (a sizing grid without sizes), BUSY (a mutation is running on

@@ -37,9 +37,10 @@ pub struct abgs_remesh_params {
     /// A body expected to make more than twice this many triangles is cut
     /// along its creases into pieces of about this many, remeshed side by
     /// side (README "Large bodies in pieces"); the pieces do not depend on
-    /// the thread count. >= 0; 0 = never cut (default 50000). Added after
-    /// the first release: a caller whose `struct_size` ends before it gets
-    /// the default.
+    /// the thread count. 0 = never cut, else >= 1 (default 50000). Added
+    /// after the first release: a caller whose `struct_size` ends before it
+    /// gets the default, so grids of bodies that large differ from those of
+    /// earlier versions.
     pub piece_faces: f64,
 }
 
@@ -79,7 +80,9 @@ pub struct abgs_remesh_report {
     /// their texts come from `abgs_grid_remesh_issue`.
     pub n_issues: u64,
     /// Pieces the large bodies were cut into (0 when none was cut; see
-    /// `piece_faces`). Added after the first release.
+    /// `piece_faces`). A cut whose seams would leave zero-area triangles is
+    /// undone (remeshed whole): then 0, and `n_issues` counts the undoing.
+    /// Added after the first release.
     pub pieces: u64,
 }
 
@@ -172,9 +175,9 @@ fn to_params(p: &abgs_remesh_params) -> FfiResult<RemeshParams> {
     if !(p.n_circle > 0.0 && p.n_circle <= 1e9) {
         return invalid(format!("n_circle = {} must be in (0, 1e9]", p.n_circle));
     }
-    if p.piece_faces < 0.0 {
+    if p.piece_faces != 0.0 && p.piece_faces < 1.0 {
         return invalid(format!(
-            "piece_faces = {} must be >= 0 (0: never cut)",
+            "piece_faces = {} must be >= 1, or 0 to never cut",
             p.piece_faces
         ));
     }
@@ -219,10 +222,10 @@ fn to_params(p: &abgs_remesh_params) -> FfiResult<RemeshParams> {
 /// `input` and `sizing` are only read (other const calls may run on them
 /// meanwhile; a mutating call on them returns BUSY until this one returns).
 /// Cost: O(F log F) per iteration, parallel on the rayon thread pool: bodies
-/// side by side, and a body expected to make more than 100,000 triangles cut
-/// along its creases into pieces of about 50,000 that run side by side too
-/// (README "Large bodies in pieces"). The result does not depend on the
-/// thread count.
+/// side by side, and a body expected to make more than 2 × `piece_faces`
+/// (default 50,000) triangles cut along its creases into pieces that run
+/// side by side too (README "Large bodies in pieces"). The result does not
+/// depend on the thread count.
 ///
 /// Errors: NULL (input, out_grid), NON_FINITE / INVALID_ARGUMENT (parameters),
 /// NO_SIZES (a sizing grid without sizes), BUSY (a mutation is running on

@@ -247,9 +247,9 @@ fn check(params: &RemeshParams) -> Result<()> {
     )?;
     within(params.sliver_angle_deg, 0.0, 60.0, "sliver_angle_deg")?;
     within(params.fidelity, 0.0, 1e9, "fidelity")?;
-    if params.piece_faces.is_nan() || params.piece_faces <= 0.0 {
+    if params.piece_faces.is_nan() || params.piece_faces < 1.0 {
         return Err(Error::InvalidArgument(format!(
-            "piece_faces = {} must be > 0 (infinite: never cut)",
+            "piece_faces = {} must be >= 1 (infinite: never cut)",
             params.piece_faces
         )));
     }

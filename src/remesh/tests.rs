@@ -193,4 +193,15 @@ fn a_large_body_is_cut_into_pieces_with_no_seam() {
         false
     )
     .is_err());
+    assert!(run(
+        &g,
+        None,
+        Some(l0),
+        &RemeshParams {
+            piece_faces: 0.5,
+            ..whole.clone()
+        },
+        false
+    )
+    .is_err());
 }

@@ -487,7 +487,7 @@ class Grid:
         (default on) caps the target at half the curvature size with
         ``n_circle`` (24) elements per circle; ``feature_angle_deg`` (30),
         ``iterations`` (10). A body expected to make more than twice
-        ``piece_faces`` (50000; 0: never) triangles is cut along its creases
+        ``piece_faces`` (50000; at least 1, or 0: never) triangles is cut along its creases
         into pieces remeshed side by side. O(F log F) per iteration,
         parallel, deterministic.
         """
