@@ -58,18 +58,17 @@ pub fn presplit(
         if points.is_empty() {
             continue;
         }
-        let k = points.len() + 1;
-        let ids: Vec<u32> = (0..k as u32 - 1).map(|i| origin + i).collect();
-        origin += k as u32 - 1;
+        let first = origin;
+        origin += points.len() as u32;
         for &e in &edges {
             let [x, y] = mesh.edge_vertices(e);
-            let (mut from, to) = if mesh.vertex_origin[x as usize] == o_lo {
-                (x, y)
+            let to = if mesh.vertex_origin[x as usize] == o_lo {
+                y
             } else {
-                (y, x)
+                x
             };
             let mut cur = e;
-            for (&(p, t), &id) in points.iter().zip(&ids) {
+            for (&(p, t), id) in points.iter().zip(first..) {
                 let v = mesh.split(cur, p);
                 mesh.vertex_flags[v as usize] = V_LOCKED | V_CORNER | V_FEATURE;
                 mesh.vertex_origin[v as usize] = id;
@@ -78,11 +77,9 @@ pub fn presplit(
                 let Some(h) = mesh.find_halfedge(v, to) else {
                     break;
                 };
-                from = v;
                 cur = mesh.edge(h);
             }
-            let _ = from;
-            pieces += k - 1;
+            pieces += points.len();
         }
     }
     pieces

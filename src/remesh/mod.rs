@@ -316,24 +316,22 @@ fn run(
         .par_iter()
         .map(|&p| sizes.target(p))
         .collect();
-    let thin = thin_patches(input, &features, &widths, &vertex_target);
-    let cut = params.piece_faces.is_finite().then(|| {
-        let narrow = narrower_than(
-            input,
-            &features,
-            &widths,
-            &vertex_target,
-            pieces::NARROW_RATIO,
-        );
-        pieces::pieces(
-            input,
-            &features,
-            &narrow,
-            &vertex_target,
-            params.piece_faces,
-        )
-    });
-    let cut = cut.flatten();
+    let least = least_target(input, &features, widths.len(), &vertex_target);
+    let thin = narrower_than(&widths, &least, THIN_RATIO);
+    let cut = params
+        .piece_faces
+        .is_finite()
+        .then(|| {
+            let narrow = narrower_than(&widths, &least, pieces::NARROW_RATIO);
+            pieces::pieces(
+                input,
+                &features,
+                &narrow,
+                &vertex_target,
+                params.piece_faces,
+            )
+        })
+        .flatten();
     let (mut mesh, build) =
         HalfedgeMesh::from_grid_cut(input, Some(&features), cut.as_ref().map(|c| &c.piece[..]));
     {
@@ -605,31 +603,30 @@ fn iterate(
     }
 }
 
-/// Patches narrower than half their target length (twice the area over the
-/// perimeter): such a strip cannot hold vertices inside (they would sit on
-/// its rims and make flat faces), so it is remeshed from its rims only.
-fn thin_patches(input: &Grid, features: &Features, width: &[f64], vt: &[f64]) -> Vec<bool> {
-    narrower_than(input, features, width, vt, 0.5)
-}
+/// Patches narrower than this many of their least target lengths (twice the
+/// area over the perimeter) are thin: such a strip cannot hold vertices
+/// inside (they would sit on its rims and make flat faces), so it is
+/// remeshed from its rims only.
+const THIN_RATIO: f64 = 0.5;
 
-/// Patches narrower than `ratio` times their least target length.
-fn narrower_than(
-    input: &Grid,
-    features: &Features,
-    width: &[f64],
-    vt: &[f64],
-    ratio: f64,
-) -> Vec<bool> {
-    let mut target = vec![f64::INFINITY; width.len()];
+/// The least target length at the input vertices of each of the `patches`.
+/// O(F).
+fn least_target(input: &Grid, features: &Features, patches: usize, vt: &[f64]) -> Vec<f64> {
+    let mut least = vec![f64::INFINITY; patches];
     for (f, tri) in input.triangles().iter().enumerate() {
         let p = features.face_patch[f] as usize;
         for &i in tri {
-            target[p] = target[p].min(vt[i as usize]);
+            least[p] = least[p].min(vt[i as usize]);
         }
     }
+    least
+}
+
+/// Patches narrower than `ratio` times their least target length.
+fn narrower_than(width: &[f64], least: &[f64], ratio: f64) -> Vec<bool> {
     width
         .iter()
-        .zip(&target)
+        .zip(least)
         .map(|(&w, &t)| w < ratio * t)
         .collect()
 }
