@@ -1,6 +1,9 @@
 /* Remeshing through the C ABI: defaults, uniform and size-driven modes, the
    report, kept feature edges, issue texts, and every error path. */
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
 #include <stdlib.h>
 #include "check.h"
 
@@ -113,6 +116,36 @@ int main(void) {
         CHECK_STATUS(abgs_grid_remesh(cube, NULL, &pp, &cut, &rp), ABGS_OK);
         CHECK(rp.pieces == 0 && rp.faces_out == r.faces_out);
         CHECK_STATUS(abgs_grid_free(cut), ABGS_OK);
+    }
+
+    /* A caller built against the first released header (before piece_faces
+       and pieces were appended): its structs end where those fields begin.
+       The library reads and writes only those bytes, and the missing
+       parameter takes its default (a read of the -7 beyond them would be an
+       error). */
+    {
+        abgs_remesh_params old_p;
+        memset(&old_p, 0, sizeof old_p);
+        old_p.struct_size = offsetof(abgs_remesh_params, piece_faces);
+        CHECK(old_p.struct_size == 48);
+        old_p.piece_faces = -7.0;
+        CHECK_STATUS(abgs_remesh_params_default(&old_p), ABGS_OK);
+        CHECK(old_p.relative_length == 0.01 && old_p.n_circle == 24.0);
+        CHECK(old_p.piece_faces == -7.0); /* not written */
+        old_p.edge_length = 0.1;
+        abgs_remesh_report old_r;
+        memset(&old_r, 0xff, sizeof old_r);
+        old_r.struct_size = offsetof(abgs_remesh_report, pieces);
+        CHECK(old_r.struct_size == 120);
+        abgs_grid *og = NULL;
+        CHECK_STATUS(abgs_grid_remesh(cube, NULL, &old_p, &og, &old_r), ABGS_OK);
+        CHECK(old_r.struct_size == 120 && old_r.faces_out == r.faces_out);
+        CHECK(old_r.pieces == UINT64_MAX); /* not written */
+        CHECK_STATUS(abgs_grid_free(og), ABGS_OK);
+        /* One byte short of the first released size is refused. */
+        old_p.struct_size = 47;
+        CHECK_STATUS(abgs_grid_remesh(cube, NULL, &old_p, &og, NULL), ABGS_ERR_INVALID_ARGUMENT);
+        CHECK(strstr(abgs_last_error_message(), "struct_size") != NULL);
     }
 
     /* The kept feature edges run along the cube's edges. */

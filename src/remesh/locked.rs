@@ -14,12 +14,14 @@ use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED, NONE, V_CORNER, V_FEATURE, V
 use std::collections::BTreeMap;
 
 /// Splits every locked edge longer than `target` along it into pieces graded
-/// by the target ([`graded`]: bisection while a piece is longer than the
-/// least of its midpoint's target and its ends' mean); new vertices are
+/// by the target ([`cut`]: spaced by the integral of `1 / target`, each piece
+/// at most the least of its midpoint's target and its ends' mean, or, where
+/// that spacing misses the bound, bisection while a piece is over it); new vertices are
 /// locked corners with their own target as size and origins numbered from
 /// `next_origin` up, shared by the copies of one input edge (the points are
 /// computed once per input edge, from the end of lower origin, so every
-/// copy is cut at the same points). Returns the number of new pieces.
+/// copy is cut at the same points; an edge whose ids would reach
+/// [`NONE`] is left uncut). Returns the number of new pieces.
 /// Cost: O(pieces) target evaluations and splits.
 pub fn presplit(
     mesh: &mut HalfedgeMesh,
@@ -54,12 +56,21 @@ pub fn presplit(
         };
         let ends = [target(pa), target(pb)];
         let mut points: Vec<([f64; 3], f64)> = Vec::new();
-        graded(&target, pa, pb, ends, 0, &mut points);
+        cut(&target, pa, pb, ends, &mut points);
+        // Origin ids stay below `NONE`: an edge whose points would need it
+        // or more (4 billion new vertices, beyond any memory) is left uncut.
+        // (`NONE` is `u32::MAX`: a sum that does not overflow is within it.)
+        let Some(end) = u32::try_from(points.len())
+            .ok()
+            .and_then(|n| origin.checked_add(n))
+        else {
+            continue;
+        };
         if points.is_empty() {
             continue;
         }
         let first = origin;
-        origin += points.len() as u32;
+        origin = end;
         for &e in &edges {
             let [x, y] = mesh.edge_vertices(e);
             let to = if mesh.vertex_origin[x as usize] == o_lo {
@@ -85,8 +96,110 @@ pub fn presplit(
     pieces
 }
 
+// `presplit` numbers origins up to `NONE - 1` by checked `u32` sums.
+const _: () = assert!(NONE == u32::MAX);
+
 /// Deepest bisection of one locked edge: 2¹⁶ pieces at most.
 const MAX_LEVELS: u32 = 16;
+
+/// Most pieces of one locked edge cut by [`spaced`] (as [`graded`]'s).
+const MAX_PIECES: usize = 1 << MAX_LEVELS;
+
+/// Relative slack of the piece bound against rounding (a piece exactly at
+/// its target, computed a few ulps over it, still passes).
+const SLACK: f64 = 1e-9;
+
+/// The points (with their targets) that cut the segment `pa`–`pb`, ends'
+/// targets `ends`: [`spaced`] where its pieces all pass [`graded`]'s bound,
+/// else [`graded`]. Points in order from `pa`.
+fn cut(
+    target: &impl Fn([f64; 3]) -> f64,
+    pa: [f64; 3],
+    pb: [f64; 3],
+    ends: [f64; 2],
+    out: &mut Vec<([f64; 3], f64)>,
+) {
+    if !spaced(target, pa, pb, ends, out) {
+        graded(target, pa, pb, ends, 0, out);
+    }
+}
+
+/// Cuts `pa`–`pb` where the integral of `1 / target` along it reaches equal
+/// shares, into the fewest pieces each with an integral of at most 1: the
+/// spacing a graded feature line gets, each piece about its target long
+/// (a uniform target cuts evenly into `⌈length / target⌉` pieces, where
+/// bisection halves 4.1 targets into eight pieces of 0.51). The integral is
+/// the trapezoid rule on samples about half the least sampled target apart
+/// (an overestimate for a convex `1 / target`, so pieces err short). Writes
+/// the points and returns true only if every piece passes [`graded`]'s
+/// bound (at most the least of its midpoint's target and its ends' mean,
+/// within [`SLACK`]); false, writing nothing, for a segment within its
+/// target, a target that is not positive and finite at a sample, or a
+/// piece over its bound (a target that changes faster than the samples
+/// see). Cost: O(length / least target) target evaluations.
+fn spaced(
+    target: &impl Fn([f64; 3]) -> f64,
+    pa: [f64; 3],
+    pb: [f64; 3],
+    ends: [f64; 2],
+    out: &mut Vec<([f64; 3], f64)>,
+) -> bool {
+    let len = norm(sub(pa, pb));
+    let least = ends[0].min(ends[1]).min(target(lerp(pa, pb, 0.5)));
+    let finite = ends.iter().all(|t| t.is_finite()) && len.is_finite();
+    if !(least > 0.0 && finite && len > least) {
+        return false;
+    }
+    let m = (2.0 * len / least)
+        .ceil()
+        .clamp(8.0, 2.0 * MAX_PIECES as f64) as usize;
+    let step = len / m as f64;
+    // Cumulative integral at the samples `i / m` of the segment.
+    let mut cum = Vec::with_capacity(m + 1);
+    cum.push(0.0);
+    let mut prev = 1.0 / ends[0];
+    for i in 1..=m {
+        let t = if i == m {
+            ends[1]
+        } else {
+            target(lerp(pa, pb, i as f64 / m as f64))
+        };
+        if !(t > 0.0 && t.is_finite()) {
+            return false;
+        }
+        let inv = 1.0 / t;
+        cum.push(cum[i - 1] + 0.5 * (prev + inv) * step);
+        prev = inv;
+    }
+    let total = cum[m];
+    let n = (total * (1.0 - SLACK)).ceil() as usize;
+    if !(2..=MAX_PIECES).contains(&n) {
+        return false;
+    }
+    let mut points = Vec::with_capacity(n - 1);
+    let mut j = 0;
+    for k in 1..n {
+        let level = total * k as f64 / n as f64;
+        while j + 1 < m && cum[j + 1] < level {
+            j += 1;
+        }
+        let f = ((level - cum[j]) / (cum[j + 1] - cum[j])).clamp(0.0, 1.0);
+        let p = lerp(pa, pb, (j as f64 + f) / m as f64);
+        points.push((p, target(p)));
+    }
+    let mut from = (pa, ends[0]);
+    for &(p, t) in points.iter().chain(std::iter::once(&(pb, ends[1]))) {
+        let bound = target(lerp(from.0, p, 0.5)).min(0.5 * (from.1 + t));
+        // False for a NaN target too.
+        let within = norm(sub(p, from.0)) <= bound * (1.0 + SLACK);
+        if !within {
+            return false;
+        }
+        from = (p, t);
+    }
+    out.extend(points);
+    true
+}
 
 /// The points (with their targets) that cut the segment `pa`–`pb`, whose
 /// ends have the targets `ends`, into pieces each no longer than the least
@@ -122,7 +235,7 @@ mod tests {
     fn pieces(target: impl Fn([f64; 3]) -> f64, len: f64) -> Vec<(f64, f64, f64)> {
         let (pa, pb) = ([0.0; 3], [len, 0.0, 0.0]);
         let mut points = vec![(pa, target(pa))];
-        graded(&target, pa, pb, [target(pa), target(pb)], 0, &mut points);
+        cut(&target, pa, pb, [target(pa), target(pb)], &mut points);
         points.push((pb, target(pb)));
         points
             .windows(2)
@@ -147,11 +260,28 @@ mod tests {
         }
         let first = ps[0];
         assert!(first.0 <= 0.5, "first piece {first:?}");
-        // No much finer than needed: a piece is halved only when over its
-        // bound, which changes little from a piece to its halves here.
+
+        // Not finer than needed: spaced by the integral of 1 / target, each
+        // piece is over 95 % of its ends' mean target (bisection's were down
+        // to 60 %), 12 pieces where the integral is 11.8.
+        assert_eq!(ps.len(), 12);
         for &(l, ta, tb) in &ps {
-            assert!(l > 0.2 * (ta + tb), "{l} against {ta}, {tb}");
+            assert!(l > 0.95 * 0.5 * (ta + tb), "{l} against {ta}, {tb}");
         }
+    }
+
+    #[test]
+    fn a_target_that_jumps_falls_back_to_bisection_within_its_bound() {
+        // The integral's even shares put a piece across the jump longer than
+        // the small side's target: bisection cuts it, every piece within
+        // its bound, the coarse side in pieces of 4 and 2, the fine in 0.25.
+        let step = |p: [f64; 3]| if p[0] < 8.0 { 4.0 } else { 0.25 };
+        let ps = pieces(step, 16.0);
+        for &(l, ta, tb) in &ps {
+            assert!(l <= 0.5 * (ta + tb) * (1.0 + 1e-12), "{l}: {ta}, {tb}");
+        }
+        assert_eq!(ps.iter().filter(|x| x.0 > 1.0).count(), 3);
+        assert_eq!(ps.iter().filter(|x| x.0 == 0.25).count(), 32);
     }
 
     #[test]
@@ -160,8 +290,49 @@ mod tests {
         let ps = pieces(|_| 1.0, 3.9);
         assert_eq!(ps.len(), 4);
         assert!(ps.iter().all(|x| (x.0 - 0.975).abs() < 1e-12));
+        // Evenly into the fewest pieces: bisection made eight of 0.5125.
+        let ps = pieces(|_| 1.0, 4.1);
+        assert_eq!(ps.len(), 5);
+        assert!(ps.iter().all(|x| (x.0 - 0.82).abs() < 1e-12));
+        // Exactly four targets long: four pieces, not five.
+        assert_eq!(pieces(|_| 0.5, 2.0).len(), 4);
         // A target that is not positive or not finite cuts nothing.
         assert_eq!(pieces(|_| 0.0, 3.0).len(), 1);
         assert_eq!(pieces(|_| f64::NAN, 3.0).len(), 1);
+    }
+
+    /// Three triangles on one edge of length 10 (a non-manifold, locked
+    /// edge), as a half-edge mesh.
+    fn book() -> HalfedgeMesh {
+        let v = vec![
+            [0.0, 0.0, 0.0],
+            [10.0, 0.0, 0.0],
+            [5.0, 3.0, 0.0],
+            [5.0, 0.0, 3.0],
+            [5.0, -3.0, 1.0],
+        ];
+        let t = vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]];
+        let opts = crate::mesh::BuildOptions::default();
+        let g = crate::mesh::Grid::from_arrays(v, t, None, &opts).unwrap();
+        HalfedgeMesh::from_grid(&g, None).0
+    }
+
+    #[test]
+    fn origin_ids_never_reach_none() {
+        // Target 1: 10 pieces, 9 new points, numbered from 5, in each of the
+        // three copies of the edge.
+        let mut m = book();
+        assert_eq!(presplit(&mut m, |_| 1.0, 5), 3 * 9);
+        let top = m.vertex_origin.iter().filter(|&&o| o != NONE).max();
+        assert_eq!(top, Some(&13));
+        // Ids that would pass NONE - 1: the edge is left uncut, no overflow.
+        let mut m = book();
+        let before = m.n_edges();
+        assert_eq!(presplit(&mut m, |_| 1.0, NONE - 8), 0);
+        assert_eq!(m.n_edges(), before);
+        // Exactly enough ids: the last new vertex gets NONE - 1.
+        assert_eq!(presplit(&mut m, |_| 1.0, NONE - 9), 3 * 9);
+        let top = m.vertex_origin.iter().filter(|&&o| o != NONE).max();
+        assert_eq!(top, Some(&(NONE - 1)));
     }
 }
