@@ -14,15 +14,15 @@ use crate::mesh::halfedge::{HalfedgeMesh, E_LOCKED, NONE, V_CORNER, V_FEATURE, V
 use std::collections::BTreeMap;
 
 /// Splits every locked edge longer than `target` along it into pieces graded
-/// by the target ([`cut`]: spaced by the integral of `1 / target`, each piece
-/// at most the least of its midpoint's target and its ends' mean, or, where
-/// that spacing misses the bound, bisection while a piece is over it); new vertices are
-/// locked corners with their own target as size and origins numbered from
-/// `next_origin` up, shared by the copies of one input edge (the points are
-/// computed once per input edge, from the end of lower origin, so every
-/// copy is cut at the same points; an edge whose ids would reach
-/// [`NONE`] is left uncut). Returns the number of new pieces.
-/// Cost: O(pieces) target evaluations and splits.
+/// by the target ([`cut`]: bisection while a piece is longer than the least
+/// of its midpoint's target and its ends' mean, then re-spaced by the
+/// integral of `1 / target` where that makes fewer pieces within the same
+/// bound); new vertices are locked corners with their own target as size
+/// and origins numbered from `next_origin` up, shared by the copies of one
+/// input edge (the points are computed once per input edge, from the end of
+/// lower origin, so every copy is cut at the same points; an edge whose ids
+/// would pass `NONE − 1` is left uncut). Returns the number of new pieces,
+/// counted in every copy. Cost: O(pieces) target evaluations and splits.
 pub fn presplit(
     mesh: &mut HalfedgeMesh,
     target: impl Fn([f64; 3]) -> f64,
