@@ -78,6 +78,24 @@ pub(crate) fn box_grid(n: usize) -> crate::mesh::Grid {
     crate::mesh::Grid::from_arrays(v, t, None, &opts).expect("valid box")
 }
 
+/// Three fins on one edge: triangles on the segment from `(0, 0, 0)` to
+/// `(len, 0, 0)` (vertices 0 and 1), their apexes at `len / 2` along it
+/// and `len` off it in three directions (+y, −y, +z): a non-manifold edge,
+/// three bodies once split.
+pub(crate) fn three_fins(len: f64) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let h = 0.5 * len;
+    (
+        vec![
+            [0.0, 0.0, 0.0],
+            [len, 0.0, 0.0],
+            [h, len, 0.0],
+            [h, -len, 0.0],
+            [h, 0.0, len],
+        ],
+        vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
+    )
+}
+
 /// Four open sheets: three meet along the line `y = z = 0`, `0 ≤ x ≤ 1` (a
 /// non-manifold edge line: the first is bent, `z = 0.1·x·y`, the second
 /// stands on the line, the third continues the first into `y < 0`), the

@@ -228,7 +228,7 @@ mod tests {
     #[test]
     fn non_manifold_edge_separates_bodies() {
         // Three triangles on edge (0,1).
-        let t = vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]];
+        let (_, t) = crate::test_shapes::three_fins(1.0);
         let topo = Topology::build(5, &t);
         assert_eq!(topo.non_manifold_edge_count(), 1);
         assert_eq!(topo.body_count, 3);

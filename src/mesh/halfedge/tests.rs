@@ -193,14 +193,7 @@ fn link_condition_rejects() {
 #[test]
 fn non_manifold_edges_are_split_and_merged_back() {
     // Three fins on edge (0, 1) plus two cubes sharing a vertex.
-    let mut v = vec![
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [0.5, 1.0, 0.0],
-        [0.5, -1.0, 0.0],
-        [0.5, 0.0, 1.0],
-    ];
-    let mut t = vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]];
+    let (mut v, mut t) = crate::test_shapes::three_fins(1.0);
     let c = cube();
     let o = v.len() as u32;
     v.extend(c.vertices().iter().map(|p| [p[0] + 3.0, p[1], p[2]]));
