@@ -37,7 +37,9 @@
 // Prints progress on stderr and one JSON object on stdout: queries/s single
 // thread (CGAL plain and hinted, abgs plain and hinted) and all threads (CGAL
 // with std::thread, abgs batch, abgs hinted with one hint per thread), build
-// times, and the agreement. Timings are the best of R repetitions.
+// times, and the agreement. Timings are the best of R rounds; in each round
+// every timed program runs once, in turn (CGAL and abgs interleaved), so that
+// a slow stretch of a shared machine slows both sides, not one of them.
 // Exit status: 0 agreement (ties allowed), 1 an unexplained mismatch, 2 error.
 #include "harness.hpp"
 
@@ -47,6 +49,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <atomic>
+#include <functional>
 
 using namespace harness;
 
@@ -232,13 +235,18 @@ std::vector<double> make_points(const std::string &kind, const Grid &g, const Cg
     return pts;
 }
 
-/// Best wall time of `reps` runs of `f`.
-template <class F> double best_of(int reps, F f) {
-    double best = 1e300;
+/// Best wall time of each of `fs` over `reps` rounds, every function run once
+/// per round, in turn: a slow stretch of this shared machine then slows every
+/// program a little, not one of them a lot, so the ratios between them carry
+/// less of its noise than runs taken one program after the other.
+std::vector<double> best_of_rounds(int reps, const std::vector<std::function<void()>> &fs) {
+    std::vector<double> best(fs.size(), 1e300);
     for (int r = 0; r < reps; r++) {
-        double t = now();
-        f();
-        best = std::min(best, now() - t);
+        for (size_t k = 0; k < fs.size(); k++) {
+            double t = now();
+            fs[k]();
+            best[k] = std::min(best[k], now() - t);
+        }
     }
     return best;
 }
@@ -290,33 +298,37 @@ int main(int argc, char **argv) {
         for (size_t i = 0; i < n; i++) cpts[i] = Point(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
         std::vector<double> ref(n), ref_h(n), plain(n), hinted(n), batch(n), hinted_mt(n), cgal_mt(n);
 
-        double t_cgal = best_of(reps, [&] {
-            for (size_t i = 0; i < n; i++) ref[i] = cg.query(cpts[i]);
-        });
-        double t_cgal_h = best_of(reps, [&] {
-            Hint h = cg.tree.closest_point_and_primitive(cpts[0]);
-            for (size_t i = 0; i < n; i++) ref_h[i] = cg.query_hinted(cpts[i], h);
-        });
-        double t_plain = best_of(reps, [&] {
-            for (size_t i = 0; i < n; i++) check(abgs_query_size(g.g, &pts[3 * i], &plain[i]), "abgs_query_size");
-        });
-        double t_hinted = best_of(reps, [&] {
-            uint32_t hint = ABGS_NO_HINT;
-            for (size_t i = 0; i < n; i++)
-                check(abgs_query_size_hinted(g.g, &pts[3 * i], &hint, &hinted[i]), "abgs_query_size_hinted");
-        });
-        double t_cgal_mt = best_of(reps, [&] {
-            parallel_chunks(n, threads, [&](size_t b, size_t e, unsigned) {
-                for (size_t i = b; i < e; i++) cgal_mt[i] = cg.query(cpts[i]);
-            });
-        });
-        double t_batch = best_of(reps, [&] { check(abgs_query_sizes(g.g, pts.data(), n, batch.data()), "abgs_query_sizes"); });
-        double t_hinted_mt = best_of(reps, [&] {
-            parallel_chunks(n, threads, [&](size_t b, size_t e, unsigned) {
+        const std::vector<double> t = best_of_rounds(reps, {
+            [&] {
+                for (size_t i = 0; i < n; i++) ref[i] = cg.query(cpts[i]);
+            },
+            [&] {
+                Hint h = cg.tree.closest_point_and_primitive(cpts[0]);
+                for (size_t i = 0; i < n; i++) ref_h[i] = cg.query_hinted(cpts[i], h);
+            },
+            [&] {
+                for (size_t i = 0; i < n; i++) check(abgs_query_size(g.g, &pts[3 * i], &plain[i]), "abgs_query_size");
+            },
+            [&] {
                 uint32_t hint = ABGS_NO_HINT;
-                for (size_t i = b; i < e; i++) abgs_query_size_hinted(g.g, &pts[3 * i], &hint, &hinted_mt[i]);
-            });
+                for (size_t i = 0; i < n; i++)
+                    check(abgs_query_size_hinted(g.g, &pts[3 * i], &hint, &hinted[i]), "abgs_query_size_hinted");
+            },
+            [&] {
+                parallel_chunks(n, threads, [&](size_t b, size_t e, unsigned) {
+                    for (size_t i = b; i < e; i++) cgal_mt[i] = cg.query(cpts[i]);
+                });
+            },
+            [&] { check(abgs_query_sizes(g.g, pts.data(), n, batch.data()), "abgs_query_sizes"); },
+            [&] {
+                parallel_chunks(n, threads, [&](size_t b, size_t e, unsigned) {
+                    uint32_t hint = ABGS_NO_HINT;
+                    for (size_t i = b; i < e; i++) abgs_query_size_hinted(g.g, &pts[3 * i], &hint, &hinted_mt[i]);
+                });
+            },
         });
+        const double t_cgal = t[0], t_cgal_h = t[1], t_plain = t[2], t_hinted = t[3], t_cgal_mt = t[4],
+                     t_batch = t[5], t_hinted_mt = t[6];
 
         // Agreement: every answer (abgs' and CGAL's hinted / threaded) against
         // CGAL's plain one, both sides with the tie rule between bodies.
