@@ -51,7 +51,8 @@ echo "cc: $(command -v "$cc_bin"); $(cmake --version | head -1); pkg-config $(pk
 # --- library -----------------------------------------------------------------
 step "library"
 if [[ ! -f $repo/target/release/libabgs.so || ! -f $repo/target/release/libabgs.a ]]; then
-  (cd "$repo" && run cargo build --release --lib)
+  # Features unified over the workspace, as scripts/install.sh builds.
+  (cd "$repo" && run cargo build --release --workspace --lib)
 fi
 ls -l "$repo/target/release/libabgs.so" "$repo/target/release/libabgs.a"
 

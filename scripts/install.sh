@@ -5,8 +5,13 @@
 #   PREFIX/lib/pkgconfig/abgs.pc
 # Usage: scripts/install.sh PREFIX
 # Environment: ABGS_NO_BUILD=1 installs the existing target/release build without
-# running `cargo build --release --lib` first; DESTDIR=dir stages the files
-# under dir (the paths written into abgs.pc stay PREFIX).
+# running `cargo build --release --workspace --lib` first; DESTDIR=dir stages the
+# files under dir (the paths written into abgs.pc stay PREFIX).
+# The build unifies features over the workspace, as `cargo build --release
+# --workspace`, the Python package's build and bench/paper_tables.sh do: a plain
+# `--lib` build resolves the proc-macros' syn without the CLI's features and so
+# recompiles every dependency that uses them (tract's crates, about ten minutes
+# on 2 cores) after a workspace build, instead of finding it fresh.
 set -euo pipefail
 
 if [[ $# -ne 1 || -z $1 ]]; then
@@ -37,13 +42,13 @@ if [[ ! $version =~ ^[0-9]+\.[0-9]+\.[0-9]+ ]]; then
 fi
 
 if [[ ${ABGS_NO_BUILD:-0} != 1 ]]; then
-  echo "install.sh: cargo build --release --lib (in $repo)"
-  (cd "$repo" && cargo build --release --lib)
+  echo "install.sh: cargo build --release --workspace --lib (in $repo)"
+  (cd "$repo" && cargo build --release --workspace --lib)
 fi
 libdir="$repo/target/release"
 for f in libabgs.so libabgs.a; do
   if [[ ! -f $libdir/$f ]]; then
-    echo "install.sh: $libdir/$f is missing; run cargo build --release --lib" >&2
+    echo "install.sh: $libdir/$f is missing; run cargo build --release --workspace --lib" >&2
     exit 1
   fi
 done

@@ -3,7 +3,7 @@
 #   1. installs what is missing (as root, with apt: cmake, a C compiler,
 #      pkg-config, openmpi-bin + libopenmpi-dev, python3-venv and the X/GL
 #      libraries the Gmsh wheel links to) and gmsh==4.15.2 (pip) into a venv;
-#   2. scripts/install.sh PREFIX (its `cargo build --release --lib` is a no-op
+#   2. scripts/install.sh PREFIX (its `cargo build --release --workspace --lib` is a no-op
 #      when the library is built; ABGS_NO_BUILD=1 skips it);
 #   3. builds the examples twice: with CMake through find_package(abgs)
 #      (-DCMAKE_PREFIX_PATH=PREFIX, -DGMSH_ROOT=venv), and with one cc / mpicc

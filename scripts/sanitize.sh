@@ -21,7 +21,12 @@ cflags=(-std=c11 -D_POSIX_C_SOURCE=200809L -g -O1 -Wall -Wextra -Werror -Iinclud
 if [[ $what == all || $what == asan ]]; then
   echo "== ASan + UBSan: library built with -Zsanitizer=address"
   host=$(rustc -vV | sed -n 's/^host: //p')
-  RUSTFLAGS="-Zsanitizer=address" cargo +nightly build --quiet --lib --target "$host" --target-dir target/asan
+  # Third-party crates at opt-level 0 here (the dev profile gives them 2): the
+  # sanitized build compiles every dependency again (tract's crates above all),
+  # and unoptimized they build in less time than the tests then run longer.
+  RUSTFLAGS="-Zsanitizer=address" cargo +nightly build --quiet --lib --target "$host" --target-dir target/asan \
+    --config 'profile.dev.package."*".opt-level=0'
+  echo "   library built in ${SECONDS} s"
   lib=target/asan/$host/debug
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:halt_on_error=1
   # Third-party leaks only, each explained in the file.
@@ -39,6 +44,7 @@ if [[ $what == all || $what == asan ]]; then
     fi
   done
   ((failed == 0)) || { echo "sanitizer run failed"; exit 1; }
+  echo "   C tests done at ${SECONDS} s"
 fi
 
 if [[ $what == all || $what == valgrind ]]; then
@@ -46,7 +52,7 @@ if [[ $what == all || $what == valgrind ]]; then
   if ! command -v valgrind > /dev/null; then
     apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq valgrind > /dev/null
   fi
-  [[ -f target/release/libabgs.so ]] || cargo build --release --lib
+  [[ -f target/release/libabgs.so ]] || cargo build --release --workspace --lib
   gcc -std=c11 -O2 -g -Wall -Wextra -Werror -pedantic -Iinclude examples_c/pipeline.c \
     -Ltarget/release -labgs -Wl,-rpath,"$repo/target/release" -o "$tmp/pipeline"
   model=../shared/meshes/gmsh_t20_component8.stl

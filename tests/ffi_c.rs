@@ -5,6 +5,11 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::{Duration, Instant};
+
+/// How long one C test may run before it counts as hung: each takes seconds
+/// in a debug build, so this is far from any honest run on a slow machine.
+const HANG_LIMIT: Duration = Duration::from_secs(900);
 
 /// Directory holding the cdylib built for this test run (`target/<profile>/deps`).
 fn lib_dir() -> PathBuf {
@@ -46,19 +51,49 @@ fn compile_and_run(source: &Path, out_dir: &Path, lib: &Path) {
     let status = cmd.status().expect("run the C compiler");
     assert!(status.success(), "compiling {} failed", source.display());
     // cargo puts target/<profile> on LD_LIBRARY_PATH, which would beat the rpath.
-    let output = Command::new(&exe)
+    // Output goes to files, so a child that fills a pipe cannot block.
+    let log_out = out_dir.join(format!("{}.stdout", source.file_stem().unwrap().display()));
+    let log_err = out_dir.join(format!("{}.stderr", source.file_stem().unwrap().display()));
+    let mut child = Command::new(&exe)
         .arg(out_dir)
         .env("LD_LIBRARY_PATH", lib)
-        .output()
+        .stdout(std::fs::File::create(&log_out).unwrap())
+        .stderr(std::fs::File::create(&log_err).unwrap())
+        .spawn()
         .expect("run the C test");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    println!("{}: {}", source.display(), stdout.trim());
-    assert!(
-        output.status.success(),
-        "{} failed ({}):\n{stdout}\n{stderr}",
+    // A hang guard, not a timing check: a C test that deadlocks fails with its
+    // name instead of stalling the whole run until CI's limit.
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for the C test") {
+            break Some(status);
+        }
+        if start.elapsed() > HANG_LIMIT {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let stdout = std::fs::read_to_string(&log_out).unwrap_or_default();
+    let stderr = std::fs::read_to_string(&log_err).unwrap_or_default();
+    println!(
+        "{}: {} ({:.1} s)",
         source.display(),
-        output.status
+        stdout.trim(),
+        start.elapsed().as_secs_f64()
+    );
+    let Some(status) = status else {
+        panic!(
+            "{} still ran after {} s (a deadlock?), killed:\n{stdout}\n{stderr}",
+            source.display(),
+            HANG_LIMIT.as_secs()
+        );
+    };
+    assert!(
+        status.success(),
+        "{} failed ({status}):\n{stdout}\n{stderr}",
+        source.display()
     );
 }
 
