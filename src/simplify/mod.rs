@@ -54,7 +54,7 @@ use crate::error::{Error, Result};
 use crate::mesh::feature_lines::{feature_lines, FeatureLines};
 use crate::mesh::halfedge::{HalfedgeMesh, NONE, V_CORNER};
 use crate::mesh::{BuildOptions, Features, Grid};
-use crate::spatial::LabelForest;
+use crate::spatial::{LabelForest, StarTables};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -433,6 +433,9 @@ struct TargetParts {
     /// Per target vertex: its reach (see
     /// [`crate::spatial::StarMesh`]).
     reach: Vec<f64>,
+    /// The star search's slot-ordered stars (see
+    /// [`crate::spatial::StarTables`]).
+    stars: StarTables,
     /// A BVH per target patch.
     patches: LabelForest,
 }
@@ -449,6 +452,7 @@ impl TargetParts {
             envelope: &self.envelope,
             contact: grid.contact_faces(),
             reach: &self.reach,
+            stars: &self.stars,
             patches: &self.patches,
         }
     }
@@ -477,7 +481,13 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
         .collect();
     let lim = params.limits();
     let envelope = envelope::Envelope::compute(grid, sizes, &features, lim.size_term, lim.kappa);
-    let reach = Target::star_mesh(grid, &features.face_patch).reaches();
+    let stars = StarTables::build(
+        grid.triangles(),
+        &grid.topology().vertex_faces,
+        Some(&features.face_patch),
+        grid.bvh(),
+    );
+    let reach = Target::star_mesh(grid, &features.face_patch, &stars).reaches();
     let patches = LabelForest::build(
         grid.vertices(),
         grid.triangles(),
@@ -497,6 +507,7 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
             seg_sizes,
             envelope,
             reach,
+            stars,
             patches,
         },
     ))

@@ -25,7 +25,7 @@ use crate::geometry::{cross, lerp, sub};
 use crate::mesh::feature_lines::FeatureLines;
 use crate::mesh::shape::unit;
 use crate::mesh::Grid;
-use crate::spatial::{LabelForest, StarMesh};
+use crate::spatial::{LabelForest, StarMesh, StarTables};
 
 /// Where a point lands on the target.
 #[derive(Debug, Clone, Copy)]
@@ -65,6 +65,8 @@ pub struct Target<'a> {
     /// not containing it), for searches that start from a known triangle
     /// ([`StarMesh::reaches`]).
     pub reach: &'a [f64],
+    /// The star search's slot-ordered stars ([`StarTables`]).
+    pub stars: &'a StarTables,
     /// A BVH per patch, for the projections the star search cannot
     /// certify (see [`LabelForest`]).
     pub patches: &'a LabelForest,
@@ -73,7 +75,7 @@ pub struct Target<'a> {
 impl<'a> Target<'a> {
     /// The target grid's triangles, vertex stars and patches, as the
     /// certified star search reads them.
-    pub fn star_mesh(grid: &'a Grid, face_patch: &'a [u32]) -> StarMesh<'a> {
+    pub fn star_mesh(grid: &'a Grid, face_patch: &'a [u32], stars: &'a StarTables) -> StarMesh<'a> {
         let topo = grid.topology();
         StarMesh {
             vertices: grid.vertices(),
@@ -82,6 +84,7 @@ impl<'a> Target<'a> {
             star_faces: &topo.vertex_faces,
             labels: face_patch,
             bvh: grid.bvh(),
+            tables: stars,
         }
     }
 
@@ -115,8 +118,8 @@ impl<'a> Target<'a> {
     /// [`LabelForest`]). O(1) near the hint, O(log F) typically.
     pub fn on_patch(&self, p: [f64; 3], patch: u32, hint: u32) -> Option<Hit> {
         let bvh = self.grid.bvh();
-        let near =
-            Target::star_mesh(self.grid, self.face_patch).closest_near(self.reach, p, patch, hint);
+        let near = Target::star_mesh(self.grid, self.face_patch, self.stars)
+            .closest_near(self.reach, p, patch, hint);
         let hit = match near {
             Ok(hit) => hit,
             Err(seed) => {

@@ -18,4 +18,4 @@ pub use layout::BvhLayout;
 pub(crate) use prism::walk_reach2;
 pub use prism::{PrismMesh, PrismSlot, Prisms};
 pub use ray::ray_triangle;
-pub use star::StarMesh;
+pub use star::{StarFace, StarMesh, StarTables};
