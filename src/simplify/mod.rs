@@ -484,7 +484,7 @@ fn setup(grid: &Grid, params: &SimplifyParams) -> Result<(HalfedgeMesh, TargetPa
     let stars = StarTables::build(
         grid.triangles(),
         &grid.topology().vertex_faces,
-        Some(&features.face_patch),
+        &features.face_patch,
         grid.bvh(),
     );
     let reach = Target::star_mesh(grid, &features.face_patch, &stars).reaches();

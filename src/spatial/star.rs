@@ -50,10 +50,11 @@
 //! BVH slot and label side by side, and each slot's corner vertices, so a
 //! face costs one read of its entry and one of its corners (leaf order)
 //! instead of a chain through the triangle's label, its slot and its
-//! vertices, each in input order, each a cache miss on a large grid. On
-//! occt_bearing_housing's dense grid (88,819 triangles) the chained search
-//! was 26 % of LBO-ABGS's time, most of it stalled on those reads
-//! (`perf`). 36 bytes per triangle, built in O(F). Ties the search to the
+//! vertices, each in input order. On occt_bearing_housing's dense grid
+//! (88,819 triangles) the chained search's own instructions were 26 % of
+//! `perf`'s samples of `abgs simplify`, most of them on those reads; on
+//! trimesh_fm1_satellite (1.46 M) the tables took the simplification from
+//! 337 to 288 s. 36 bytes per triangle, built in O(F). Ties the search to the
 //! mesh's vertex stars and to the BVH (corners in leaf order, the same
 //! corner order as the tree's search, so distances are the same bits).
 
@@ -91,20 +92,22 @@ pub struct StarTables {
 }
 
 impl StarTables {
-    /// The tables of `triangles` with stars `star_offsets`/`star_faces`
-    /// (compressed rows of triangle indices), `labels` per triangle (`None`:
-    /// all 0) and the BVH `bvh` over them. O(F), 36 bytes per triangle.
+    /// The tables of `triangles` with stars `star_faces` (the rows of
+    /// triangle indices that [`StarMesh::star_offsets`] delimits), `labels`
+    /// per triangle and the BVH `bvh` over them: the same arrays the
+    /// [`StarMesh`] that reads the tables holds. O(F), 36 bytes per
+    /// triangle.
     pub fn build(
         triangles: &[[u32; 3]],
         star_faces: &[u32],
-        labels: Option<&[u32]>,
+        labels: &[u32],
         bvh: &Bvh,
     ) -> StarTables {
         let faces = star_faces
             .iter()
             .map(|&u| StarFace {
                 slot: bvh.triangle_prim[u as usize],
-                label: labels.map_or(0, |l| l[u as usize]),
+                label: labels[u as usize],
             })
             .collect();
         let slot_vertices = bvh
@@ -116,11 +119,6 @@ impl StarTables {
             faces,
             slot_vertices,
         }
-    }
-
-    /// Heap bytes held. O(1).
-    pub fn memory_bytes(&self) -> usize {
-        self.faces.capacity() * std::mem::size_of::<StarFace>() + self.slot_vertices.capacity() * 12
     }
 }
 
@@ -306,7 +304,7 @@ mod tests {
         fn new(v: Vec<[f64; 3]>, t: Vec<[u32; 3]>, labels: Vec<u32>) -> Surface {
             let topo = Topology::build(v.len(), &t);
             let bvh = Bvh::build(&v, &t);
-            let tables = StarTables::build(&t, &topo.vertex_faces, Some(&labels), &bvh);
+            let tables = StarTables::build(&t, &topo.vertex_faces, &labels, &bvh);
             Surface {
                 v,
                 t,
